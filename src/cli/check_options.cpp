@@ -1,0 +1,45 @@
+#include "cli/check_options.hpp"
+
+#include "io/properties_file.hpp"
+
+namespace rvc::cli {
+
+void CheckOptions::add_to(CLI::App& app) {
+  app.add_option("--spec,-s", specs, "A property in Rye syntax (repeatable; named p1, p2, ...)");
+  app.add_option("--properties,-p", properties_file, "YAML/JSON file of named properties")->check(CLI::ExistingFile);
+  app.add_flag("--dense", dense, "Dense time: messages carry a time field; values hold until the next message");
+  app.add_flag("--all", all, "Report the verdict at every step, not only changes");
+  app.add_flag("--strict", strict, "Reject messages missing a field a property tests, or with wrong types");
+  app.add_option("--time-field", time_field, "Name of the time field in dense time")->capture_default_str();
+  app.add_option("--max-message-size", max_message_size, "Longest accepted message in bytes")->capture_default_str();
+  app.add_option("--max-errors", max_reported, "Errors and warnings printed before going quiet (all are counted)")
+      ->capture_default_str();
+}
+
+std::vector<engine::PropertySpec> CheckOptions::properties() const {
+  std::vector<engine::PropertySpec> out;
+  for (size_t i = 0; i < specs.size(); ++i) out.push_back({"p" + std::to_string(i + 1), specs[i]});
+  if (!properties_file.empty()) {
+    auto more = io::load_properties(properties_file);
+    for (auto& p : more) {
+      for (const auto& q : out)
+        if (q.name == p.name)
+          throw io::PropertiesError(properties_file + ": property name '" + p.name + "' is also used by --spec");
+      out.push_back(std::move(p));
+    }
+  }
+  if (out.empty()) throw CLI::ValidationError("give a property with --spec or --properties");
+  return out;
+}
+
+PipelineOptions CheckOptions::pipeline_options() const {
+  PipelineOptions o;
+  o.model = dense ? engine::TimeModel::Dense : engine::TimeModel::Discrete;
+  o.emit_all = all;
+  o.strict = strict;
+  o.time_field = time_field;
+  o.max_reported = max_reported;
+  return o;
+}
+
+}  // namespace rvc::cli

@@ -1,0 +1,30 @@
+// Options shared by `rvc check` and `rvc monitor`: what to check and how.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include <string>
+#include <vector>
+
+#include "cli/pipeline.hpp"
+#include "engine/checker.hpp"
+
+namespace rvc::cli {
+
+struct CheckOptions {
+  std::vector<std::string> specs;
+  std::string properties_file;
+  bool dense = false;
+  bool all = false;
+  bool strict = false;
+  std::string time_field = "time";
+  size_t max_message_size = 1 << 20;
+  size_t max_reported = 100;
+
+  void add_to(CLI::App& app);
+  // The properties from --spec (named p1, p2, ...) and --properties.
+  std::vector<engine::PropertySpec> properties() const;
+  PipelineOptions pipeline_options() const;
+};
+
+}  // namespace rvc::cli

@@ -1,0 +1,24 @@
+// Each subcommand registers its options on the CLI11 app and returns the
+// function that runs it (called only if that subcommand was chosen).
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include <functional>
+
+namespace rvc::cli {
+
+using Runner = std::function<int()>;
+
+// Exit codes shared by all subcommands (documented in docs/cli.md).
+enum ExitCode : int {
+  kOk = 0,          // every property held
+  kViolated = 1,    // some property was violated
+  kUsage = 2,       // bad arguments, bad spec, unreadable files
+  kBadInput = 3,    // messages were rejected (and no property was violated)
+};
+
+Runner register_check(CLI::App& app);
+Runner register_timescales(CLI::App& app);
+
+}  // namespace rvc::cli

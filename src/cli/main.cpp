@@ -1,0 +1,40 @@
+// rvc: one binary, thin subcommands that wire endpoints to stages.
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <map>
+
+#include "cli/commands.hpp"
+#include "io/properties_file.hpp"
+#include "spec/spec_error.hpp"
+
+int main(int argc, char** argv) {
+  using namespace rvc::cli;
+  CLI::App app{"rvc: runtime verification of pub/sub traffic against past-time temporal logic (Rye syntax)"};
+  app.set_version_flag("--version", std::string("rvc ") + RVC_VERSION);
+  app.require_subcommand(1);
+  std::map<std::string, Runner> runners;
+  runners["check"] = register_check(app);
+  runners["timescales"] = register_timescales(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : kUsage;
+  }
+  try {
+    for (CLI::App* sub : app.get_subcommands()) return runners.at(sub->get_name())();
+  } catch (const rvc::spec::SpecError& e) {
+    std::fprintf(stderr, "rvc: %s\n", e.what());
+    return kUsage;
+  } catch (const rvc::io::PropertiesError& e) {
+    std::fprintf(stderr, "rvc: %s\n", e.what());
+    return kUsage;
+  } catch (const CLI::Error& e) {
+    std::fprintf(stderr, "rvc: %s\n", e.what());
+    return kUsage;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "rvc: error: %s\n", e.what());
+    return kUsage;
+  }
+  return kUsage;
+}

@@ -1,0 +1,93 @@
+#include "cli/pipeline.hpp"
+
+#include <cstdio>
+
+#include "io/verdict_writer.hpp"
+#include "spec/spec_error.hpp"
+
+namespace rvc::cli {
+namespace {
+
+engine::Checker build(const std::vector<engine::PropertySpec>& properties, const PipelineOptions& options,
+                      engine::VerdictCallback on_verdict) {
+  engine::Checker checker(options.model, options.emit_all, std::move(on_verdict));
+  for (const auto& p : properties) {
+    try {
+      checker.add_property(p);
+    } catch (const spec::SpecError& e) {
+      throw spec::SpecError("in property '" + p.name + "': " + e.message(), e.source(), e.column());
+    }
+  }
+  return checker;
+}
+
+std::string number(double v) {
+  std::string s;
+  io::append_number(s, v);
+  return s;
+}
+
+}  // namespace
+
+Pipeline::Pipeline(const std::vector<engine::PropertySpec>& properties, const PipelineOptions& options,
+                   engine::VerdictCallback on_verdict)
+    : checker_(build(properties, options, std::move(on_verdict))),
+      options_(options),
+      decoder_(checker_.atoms(), io::DecoderOptions{options.model == engine::TimeModel::Dense, options.time_field,
+                                                    options.strict}) {}
+
+void Pipeline::report(const std::string& text) {
+  if (reported_++ < options_.max_reported) std::fprintf(stderr, "rvc: %s\n", text.c_str());
+}
+
+void Pipeline::on_error(const io::LineError& error) {
+  ++stats_.rejected;
+  std::string where = options_.position_name + " " + std::to_string(error.line);
+  if (error.column) where += ", column " + std::to_string(error.column);
+  report(where + ": " + error.message + " (message skipped)");
+}
+
+void Pipeline::on_object(uint64_t position, simdjson::ondemand::object object) {
+  std::string error;
+  warnings_.clear();
+  if (!decoder_.decode(object, error, &warnings_)) {
+    on_error(io::LineError{position, 0, error});
+    return;
+  }
+  for (const std::string& w : warnings_) {
+    ++stats_.warnings;
+    report("warning: " + options_.position_name + " " + std::to_string(position) + ": " + w);
+  }
+  if (checker_.model() == engine::TimeModel::Discrete) {
+    decoder_.commit();
+    checker_.step(decoder_.values());
+  } else {
+    // Dense: this message closes [previous time, its time) with the previous values.
+    double t = decoder_.time();
+    double begin = has_time_ ? last_time_ : 0;
+    if (!(t >= 0) || (has_time_ && !(t > last_time_))) {
+      std::string why = t < 0 ? "time " + number(t) + " is negative (the timeline starts at 0)"
+                              : "time " + number(t) + " is not after the previous message's time " +
+                                    number(last_time_) + " (dense time needs strictly increasing times)";
+      on_error(io::LineError{position, 0, why});
+      return;
+    }
+    checker_.step(begin, t, decoder_.values());
+    decoder_.commit();
+    has_time_ = true;
+    last_time_ = t;
+  }
+  ++stats_.accepted;
+}
+
+void Pipeline::feed(std::string_view payload, uint64_t position) {
+  io::parse_one(parser_, payload, position, *this, scratch_);
+}
+
+void Pipeline::finish_report() {
+  if (reported_ > options_.max_reported)
+    std::fprintf(stderr, "rvc: %llu more errors/warnings were not shown\n",
+                 static_cast<unsigned long long>(reported_ - options_.max_reported));
+}
+
+}  // namespace rvc::cli

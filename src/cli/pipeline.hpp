@@ -1,0 +1,64 @@
+// decode -> engine -> verdicts, shared by `rvc check` (files) and
+// `rvc monitor` (network): one JSON decode per message for all properties,
+// time-order checks for dense time, and counters for what was rejected.
+#pragma once
+
+#include <simdjson.h>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "engine/checker.hpp"
+#include "io/json_decoder.hpp"
+#include "io/jsonl_reader.hpp"
+
+namespace rvc::cli {
+
+struct PipelineOptions {
+  engine::TimeModel model = engine::TimeModel::Discrete;
+  bool emit_all = false;
+  bool strict = false;
+  std::string time_field = "time";
+  std::string position_name = "line";  // how errors name a message: "line 12", "seq 12"
+  size_t max_reported = 100;           // errors and warnings printed before going quiet
+};
+
+struct PipelineStats {
+  uint64_t accepted = 0;  // messages fed to the monitors
+  uint64_t rejected = 0;  // messages refused (malformed, wrong time order, strict-mode problems)
+  uint64_t warnings = 0;  // fields that kept their previous value (wrong type)
+};
+
+class Pipeline final : public io::JsonlHandler {
+ public:
+  // Throws spec::SpecError (prefixed with the property's name) for a bad spec.
+  Pipeline(const std::vector<engine::PropertySpec>& properties, const PipelineOptions& options,
+           engine::VerdictCallback on_verdict);
+
+  void on_object(uint64_t position, simdjson::ondemand::object object) override;
+  void on_error(const io::LineError& error) override;
+  // One network payload; `position` names it in errors (its sequence number).
+  void feed(std::string_view payload, uint64_t position);
+
+  const PipelineStats& stats() const { return stats_; }
+  const engine::Checker& checker() const { return checker_; }
+  bool violated() const { return checker_.violations() > 0; }
+  // Prints "N more errors were not shown" if output was cut short.
+  void finish_report();
+
+ private:
+  void report(const std::string& text);
+  engine::Checker checker_;
+  PipelineOptions options_;
+  io::JsonDecoder decoder_;
+  PipelineStats stats_;
+  bool has_time_ = false;
+  double last_time_ = 0;
+  uint64_t reported_ = 0;
+  std::vector<std::string> warnings_;
+  simdjson::ondemand::parser parser_;
+  std::string scratch_;
+};
+
+}  // namespace rvc::cli

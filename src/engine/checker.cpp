@@ -1,0 +1,43 @@
+#include "engine/checker.hpp"
+
+#include "spec/parser.hpp"
+
+namespace rvc::engine {
+
+Checker::Checker(TimeModel model, bool emit_all, VerdictCallback on_verdict)
+    : model_(model), emit_all_(emit_all), on_verdict_(std::move(on_verdict)) {}
+
+void Checker::add_property(const PropertySpec& property) {
+  spec::ParseOptions options;
+  options.dense = model_ == TimeModel::Dense;
+  spec::NodePtr ast = spec::parse(property.spec, options);
+  Program program = compile(*ast, atoms_, model_, property.spec);
+  if (model_ == TimeModel::Discrete) discrete_.emplace_back(program);
+  else dense_.emplace_back(program);
+  names_.push_back(property.name);
+  last_.push_back(-1);
+}
+
+void Checker::report(size_t property, double time, bool value) {
+  if (!emit_all_ && last_[property] == static_cast<int8_t>(value)) return;
+  last_[property] = static_cast<int8_t>(value);
+  if (!value) ++violations_;
+  if (on_verdict_) on_verdict_(Verdict{names_[property], time, value});
+}
+
+void Checker::step(const uint8_t* atoms) {
+  for (size_t i = 0; i < discrete_.size(); ++i) {
+    double now = static_cast<double>(discrete_[i].now());
+    report(i, now, discrete_[i].step(atoms));
+  }
+}
+
+void Checker::step(double begin, double end, const uint8_t* atoms) {
+  if (!(begin < end)) return;  // an empty segment has no value to report
+  for (size_t i = 0; i < dense_.size(); ++i) {
+    const dense::Signal& s = dense_[i].step(begin, end, atoms);
+    for (const dense::Piece& p : s.pieces) report(i, p.t, p.v);
+  }
+}
+
+}  // namespace rvc::engine

@@ -1,0 +1,66 @@
+// A set of named properties checked together over one stream of messages.
+// The properties share one atom table (so one decode per message) and one
+// clock; each keeps its own monitor and reports verdicts through a callback:
+// only changes by default (condensed, like Reelay), every step with emit_all.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "engine/atom_table.hpp"
+#include "engine/dense/monitor.hpp"
+#include "engine/discrete/monitor.hpp"
+#include "engine/program.hpp"
+
+namespace rvc::engine {
+
+struct Verdict {
+  const std::string& property;
+  double time;  // step index in discrete time
+  bool value;
+};
+using VerdictCallback = std::function<void(const Verdict&)>;
+
+struct PropertySpec {
+  std::string name;
+  std::string spec;
+};
+
+class Checker {
+ public:
+  Checker(TimeModel model, bool emit_all, VerdictCallback on_verdict);
+
+  // Parses and compiles; throws spec::SpecError naming the column.
+  void add_property(const PropertySpec& property);
+
+  AtomTable& atoms() { return atoms_; }
+  TimeModel model() const { return model_; }
+  size_t size() const { return names_.size(); }
+  const std::vector<std::string>& names() const { return names_; }
+
+  // Discrete time: one step with the atoms' values after the message.
+  void step(const uint8_t* atoms);
+  // Dense time: the atoms' values held over [begin, end).
+  void step(double begin, double end, const uint8_t* atoms);
+
+  uint64_t violations() const { return violations_; }  // verdicts reported false
+
+ private:
+  void report(size_t property, double time, bool value);
+
+  TimeModel model_;
+  bool emit_all_;
+  VerdictCallback on_verdict_;
+  AtomTable atoms_;
+  std::vector<std::string> names_;
+  std::vector<discrete::Monitor> discrete_;
+  std::vector<dense::Monitor> dense_;
+  std::vector<int8_t> last_;  // last reported value per property, -1 before the first
+  uint64_t violations_ = 0;
+};
+
+}  // namespace rvc::engine

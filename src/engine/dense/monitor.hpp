@@ -1,0 +1,31 @@
+// Dense-time monitor of one property. Each message at time t closes the
+// segment [t_prev, t) during which the previous values held; step() returns
+// the property's value over that segment, with every change point inside it.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "engine/dense/historically.hpp"
+#include "engine/dense/once.hpp"
+#include "engine/dense/signal.hpp"
+#include "engine/dense/since.hpp"
+#include "engine/program.hpp"
+
+namespace rvc::engine::dense {
+
+class Monitor {
+ public:
+  explicit Monitor(const Program& program);
+  const Signal& step(double begin, double end, const uint8_t* atoms);
+
+ private:
+  std::vector<Instr> code_;
+  std::vector<Signal> signal_;
+  std::vector<int32_t> state_;
+  std::vector<Once> once_;
+  std::vector<Historically> historically_;
+  std::vector<Since> since_;
+};
+
+}  // namespace rvc::engine::dense

@@ -1,0 +1,35 @@
+// A property compiled for evaluation: the AST flattened into an array of
+// instructions in post-order (children before parents, root last), each
+// naming its operands by index. Evaluating it is one pass over the array with
+// a switch: no virtual call per node per event, no pointer chasing.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "engine/atom_table.hpp"
+#include "spec/ast.hpp"
+
+namespace rvc::engine {
+
+enum class TimeModel { Discrete, Dense };
+
+enum class Code : uint8_t { True, False, Atom, Not, And, Or, Implies, Pre, Once, Historically, Since };
+
+struct Instr {
+  Code code;
+  int32_t a = -1, b = -1;  // operand instructions (a: unary/left, b: right)
+  int32_t atom = -1;       // Code::Atom: index into the atom table
+  spec::Bounds bounds;     // temporal operators
+};
+
+struct Program {
+  std::vector<Instr> code;
+};
+
+// Compiles a parsed property. Throws spec::SpecError (pointing into `source`)
+// for constructs the chosen time model cannot evaluate.
+Program compile(const spec::Node& root, AtomTable& atoms, TimeModel model, const std::string& source);
+
+}  // namespace rvc::engine

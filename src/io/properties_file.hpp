@@ -1,0 +1,23 @@
+// Loads named properties from a YAML or JSON file. Accepted shapes:
+//   properties:                      # a list of {name, spec}
+//     - name: hazard
+//       spec: historically({emergency} -> once[0:1]{hazard_lights})
+//   hazard: historically(...)        # or a plain map name -> spec
+// Names must be unique; a property without a name gets "p<N>".
+#pragma once
+
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "engine/checker.hpp"
+
+namespace rvc::io {
+
+struct PropertiesError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+std::vector<engine::PropertySpec> load_properties(const std::string& path);
+
+}  // namespace rvc::io

@@ -1,0 +1,140 @@
+#include "spec/ast.hpp"
+
+#include <cctype>
+#include <charconv>
+#include <cmath>
+
+#include "spec/spec_error.hpp"
+
+namespace rvc::spec {
+namespace {
+
+std::string number_text(double v) {
+  char buf[64];
+  auto [ptr, ec] = std::to_chars(buf, buf + sizeof buf, v);
+  return std::string(buf, ptr);
+}
+
+std::string quote_if_needed(const std::string& key) {
+  bool plain = !key.empty() && (std::isalpha(static_cast<unsigned char>(key[0])) || key[0] == '_');
+  for (char c : key) plain = plain && (std::isalnum(static_cast<unsigned char>(c)) || c == '_');
+  if (plain) return key;
+  std::string out = "\"";
+  for (char c : key) {
+    if (c == '"' || c == '\\') out.push_back('\\');
+    out.push_back(c);
+  }
+  return out + "\"";
+}
+
+std::string literal_text(const Literal& l) {
+  switch (l.kind) {
+    case Literal::Kind::Bool: return l.b ? "true" : "false";
+    case Literal::Kind::Number: return number_text(l.number);
+    case Literal::Kind::String: {
+      std::string out = "\"";
+      for (char c : l.text) {
+        if (c == '"' || c == '\\') out.push_back('\\');
+        out.push_back(c);
+      }
+      return out + "\"";
+    }
+  }
+  return "";
+}
+
+std::string bounds_text(const Bounds& b) {
+  if (!b.explicit_bounds) return "";
+  std::string out = "[";
+  if (b.lo != 0) out += number_text(b.lo);
+  out += ":";
+  if (b.hi != kInfinity) out += number_text(b.hi);
+  return out + "]";
+}
+
+}  // namespace
+
+std::string FieldTest::key() const {
+  std::string out;
+  for (size_t i = 0; i < path.size(); ++i) out += (i ? "." : "") + quote_if_needed(path[i]);
+  return out;
+}
+
+std::string FieldTest::to_string() const {
+  std::string k = key();
+  switch (op) {
+    case Op::Truthy: return k;
+    case Op::Present: return k + ": *";
+    case Op::Bind: return k + ": *" + variable;
+    case Op::Eq: return k + " == " + literal_text(value);
+    case Op::Ne: return k + " != " + literal_text(value);
+    case Op::Lt: return k + " < " + literal_text(value);
+    case Op::Le: return k + " <= " + literal_text(value);
+    case Op::Gt: return k + " > " + literal_text(value);
+    case Op::Ge: return k + " >= " + literal_text(value);
+  }
+  return k;
+}
+
+const char* op_name(Op op) {
+  switch (op) {
+    case Op::True: return "true";
+    case Op::False: return "false";
+    case Op::Test: return "atom";
+    case Op::Not: return "not";
+    case Op::Pre: return "pre";
+    case Op::Once: return "once";
+    case Op::Historically: return "historically";
+    case Op::And: return "and";
+    case Op::Or: return "or";
+    case Op::Implies: return "implies";
+    case Op::Since: return "since";
+    case Op::Exists: return "exists";
+    case Op::Forall: return "forall";
+  }
+  return "?";
+}
+
+std::string to_string(const Node& n) {
+  switch (n.op) {
+    case Op::True: return "true";
+    case Op::False: return "false";
+    case Op::Test: return "{" + n.test.to_string() + "}";
+    case Op::Not: return "(not " + to_string(*n.left) + ")";
+    case Op::Pre:
+    case Op::Once:
+    case Op::Historically:
+      return "(" + std::string(op_name(n.op)) + bounds_text(n.bounds) + " " + to_string(*n.left) + ")";
+    case Op::And:
+    case Op::Or:
+    case Op::Implies:
+      return "(" + to_string(*n.left) + " " + op_name(n.op) + " " + to_string(*n.right) + ")";
+    case Op::Since:
+      return "(" + to_string(*n.left) + " since" + bounds_text(n.bounds) + " " + to_string(*n.right) + ")";
+    case Op::Exists:
+    case Op::Forall: {
+      std::string vars;
+      for (size_t i = 0; i < n.variables.size(); ++i) vars += (i ? ", " : "") + n.variables[i];
+      return "(" + std::string(op_name(n.op)) + "[" + vars + "]. " + to_string(*n.left) + ")";
+    }
+  }
+  return "?";
+}
+
+std::string SpecError::render(const std::string& message, const std::string& source, int column) {
+  // Show the line holding the column (specs from files may span lines).
+  size_t at = column > 0 ? static_cast<size_t>(column - 1) : 0;
+  if (at > source.size()) at = source.size();
+  size_t line_start = source.rfind('\n', at == 0 ? 0 : at - 1);
+  line_start = (line_start == std::string::npos || at == 0) ? 0 : line_start + 1;
+  if (at > 0 && source[at - 1] == '\n') line_start = at;
+  size_t line_end = source.find('\n', at);
+  if (line_end == std::string::npos) line_end = source.size();
+  std::string line = source.substr(line_start, line_end - line_start);
+  std::string caret(at - line_start, ' ');
+  for (size_t i = 0; i < caret.size(); ++i)
+    if (line[i] == '\t') caret[i] = '\t';
+  return "spec error at column " + std::to_string(column) + ": " + message + "\n  " + line + "\n  " + caret + "^";
+}
+
+}  // namespace rvc::spec

@@ -1,0 +1,27 @@
+// Parser for Rye, Reelay's specification syntax.
+//
+// Precedence, tightest first (matches Reelay 25, checked by differential tests):
+//   atoms {..}, true, false, ( )
+//   unary:  not ! pre Y once P historically H          (prefix, stackable)
+//   since S [a:b]                                      (non-associative: chains need parentheses)
+//   and &&                                             (left-associative)
+//   or ||                                              (left-associative)
+//   implies ->                                         (right-associative)
+//   exists[x]. / forall[x].                            (body extends as far right as possible)
+#pragma once
+
+#include <string>
+
+#include "spec/ast.hpp"
+#include "spec/spec_error.hpp"
+
+namespace rvc::spec {
+
+struct ParseOptions {
+  bool dense = false;  // dense time accepts real-valued bounds; discrete needs integers
+};
+
+// Throws SpecError (with the column) on any problem; never returns null.
+NodePtr parse(const std::string& text, const ParseOptions& options = {});
+
+}  // namespace rvc::spec

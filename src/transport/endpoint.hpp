@@ -1,0 +1,41 @@
+// Endpoints: every subcommand names its inputs and outputs with a URI
+//   file:PATH | PATH | -   (JSON lines)
+//   zenoh:KEYEXPR          (one JSON object per sample)
+//   dds:TOPIC              (ROS 2 std_msgs/msg/String by default)
+// A Source delivers Frames to a handler; a Sink publishes payloads. Transport
+// specifics (sessions, QoS, configs) stay behind these two interfaces.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <string_view>
+
+#include "transport/frame.hpp"
+
+namespace rvc::transport {
+
+class Source {
+ public:
+  virtual ~Source() = default;
+  // Starts delivery; the handler runs on a transport thread (or the caller's
+  // thread for files). Returns once subscribed, i.e. ready to receive.
+  virtual void start(FrameHandler handler) = 0;
+  // Stops delivery; no handler call is running or will run after it returns.
+  virtual void stop() = 0;
+};
+
+class Sink {
+ public:
+  virtual ~Sink() = default;
+  // Publishes one payload. Reliable sinks block rather than drop.
+  virtual void put(std::string_view payload, uint64_t seq) = 0;
+  // Publishes the end-of-stream marker after the last payload (seq = last seq).
+  virtual void put_eos(uint64_t last_seq) = 0;
+  // Waits until at least n subscribers match; false on timeout.
+  virtual bool wait_matched(size_t n, std::chrono::milliseconds timeout) { return true; }
+  virtual void flush() {}
+};
+
+}  // namespace rvc::transport

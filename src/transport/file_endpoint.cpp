@@ -1,0 +1,1 @@
+// (placeholder translation unit; file endpoints arrive with `rvc monitor`)

@@ -1,0 +1,20 @@
+// One message as a transport hands it to rvc: borrowed payload bytes plus the
+// bookkeeping that loss accounting needs. Nothing here knows about Zenoh or DDS.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string_view>
+
+namespace rvc::transport {
+
+struct Frame {
+  std::string_view payload;  // borrowed: valid only during the callback
+  uint64_t seq = 0;          // publisher's sequence number (1-based), 0 if unknown
+  bool eos = false;          // end-of-stream marker: payload is empty, seq = last data seq
+};
+
+// Called on a transport thread. Must copy what it keeps and return quickly.
+using FrameHandler = std::function<void(const Frame&)>;
+
+}  // namespace rvc::transport
