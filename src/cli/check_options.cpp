@@ -5,7 +5,7 @@
 namespace rvc::cli {
 
 void CheckOptions::add_to(CLI::App& app) {
-  app.add_option("--spec,-s", specs, "A property in Rye syntax (repeatable; named p1, p2, ...)");
+  app.add_option("--spec,-s", specs, "A property in Rye syntax (repeatable; named p1, p2, ...)")->allow_extra_args(false);
   app.add_option("--properties,-p", properties_file, "YAML/JSON file of named properties")->check(CLI::ExistingFile);
   app.add_flag("--dense", dense, "Dense time: messages carry a time field; values hold until the next message");
   app.add_flag("--all", all, "Report the verdict at every step, not only changes");
@@ -14,6 +14,8 @@ void CheckOptions::add_to(CLI::App& app) {
   app.add_option("--max-message-size", max_message_size, "Longest accepted message in bytes")->capture_default_str();
   app.add_option("--max-errors", max_reported, "Errors and warnings printed before going quiet (all are counted)")
       ->capture_default_str();
+  app.add_flag("--parse-only", parse_only, "Decode messages but run no monitor (the benchmark's floor)")
+      ->group("");  // hidden: for bench/, not for users
 }
 
 std::vector<engine::PropertySpec> CheckOptions::properties() const {
@@ -39,6 +41,7 @@ PipelineOptions CheckOptions::pipeline_options() const {
   o.strict = strict;
   o.time_field = time_field;
   o.max_reported = max_reported;
+  o.parse_only = parse_only;
   return o;
 }
 

@@ -16,9 +16,13 @@ enum ExitCode : int {
   kViolated = 1,    // some property was violated
   kUsage = 2,       // bad arguments, bad spec, unreadable files
   kBadInput = 3,    // messages were rejected (and no property was violated)
+  kLost = 4,        // messages were lost or duplicated in transit (rvc monitor)
 };
 
 Runner register_check(CLI::App& app);
 Runner register_timescales(CLI::App& app);
+Runner register_monitor(CLI::App& app);
+Runner register_replay(CLI::App& app);
+Runner register_router(CLI::App& app);  // only with the Zenoh transport
 
 }  // namespace rvc::cli

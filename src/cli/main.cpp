@@ -16,6 +16,11 @@ int main(int argc, char** argv) {
   std::map<std::string, Runner> runners;
   runners["check"] = register_check(app);
   runners["timescales"] = register_timescales(app);
+  runners["monitor"] = register_monitor(app);
+  runners["replay"] = register_replay(app);
+#ifdef RVC_HAVE_ZENOH
+  runners["router"] = register_router(app);
+#endif
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -30,6 +35,9 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "rvc: %s\n", e.what());
     return kUsage;
   } catch (const CLI::Error& e) {
+    std::fprintf(stderr, "rvc: %s\n", e.what());
+    return kUsage;
+  } catch (const std::invalid_argument& e) {
     std::fprintf(stderr, "rvc: %s\n", e.what());
     return kUsage;
   } catch (const std::exception& e) {

@@ -47,18 +47,24 @@ void Pipeline::on_error(const io::LineError& error) {
   report(where + ": " + error.message + " (message skipped)");
 }
 
-void Pipeline::on_object(uint64_t position, simdjson::ondemand::object object) {
+bool Pipeline::on_object(const io::Position& where, simdjson::ondemand::object object) {
   std::string error;
   warnings_.clear();
   if (!decoder_.decode(object, error, &warnings_)) {
-    on_error(io::LineError{position, 0, error});
-    return;
+    if (decoder_.malformed()) {  // the reader re-reads this stretch and reports it
+      json_error_ = error;
+      return false;
+    }
+    on_error(io::LineError{where.number(), 0, error});
+    return true;
   }
   for (const std::string& w : warnings_) {
     ++stats_.warnings;
-    report("warning: " + options_.position_name + " " + std::to_string(position) + ": " + w);
+    report("warning: " + options_.position_name + " " + std::to_string(where.number()) + ": " + w);
   }
-  if (checker_.model() == engine::TimeModel::Discrete) {
+  if (options_.parse_only) {
+    decoder_.commit();
+  } else if (checker_.model() == engine::TimeModel::Discrete) {
     decoder_.commit();
     checker_.step(decoder_.values());
   } else {
@@ -69,8 +75,8 @@ void Pipeline::on_object(uint64_t position, simdjson::ondemand::object object) {
       std::string why = t < 0 ? "time " + number(t) + " is negative (the timeline starts at 0)"
                               : "time " + number(t) + " is not after the previous message's time " +
                                     number(last_time_) + " (dense time needs strictly increasing times)";
-      on_error(io::LineError{position, 0, why});
-      return;
+      on_error(io::LineError{where.number(), 0, why});
+      return true;
     }
     checker_.step(begin, t, decoder_.values());
     decoder_.commit();
@@ -78,6 +84,7 @@ void Pipeline::on_object(uint64_t position, simdjson::ondemand::object object) {
     last_time_ = t;
   }
   ++stats_.accepted;
+  return true;
 }
 
 void Pipeline::feed(std::string_view payload, uint64_t position) {

@@ -22,6 +22,7 @@ struct PipelineOptions {
   std::string time_field = "time";
   std::string position_name = "line";  // how errors name a message: "line 12", "seq 12"
   size_t max_reported = 100;           // errors and warnings printed before going quiet
+  bool parse_only = false;             // decode every message but run no monitor (benchmark floor)
 };
 
 struct PipelineStats {
@@ -36,7 +37,8 @@ class Pipeline final : public io::JsonlHandler {
   Pipeline(const std::vector<engine::PropertySpec>& properties, const PipelineOptions& options,
            engine::VerdictCallback on_verdict);
 
-  void on_object(uint64_t position, simdjson::ondemand::object object) override;
+  bool on_object(const io::Position& position, simdjson::ondemand::object object) override;
+  std::string json_error() const override { return json_error_; }
   void on_error(const io::LineError& error) override;
   // One network payload; `position` names it in errors (its sequence number).
   void feed(std::string_view payload, uint64_t position);
@@ -57,6 +59,7 @@ class Pipeline final : public io::JsonlHandler {
   double last_time_ = 0;
   uint64_t reported_ = 0;
   std::vector<std::string> warnings_;
+  std::string json_error_;
   simdjson::ondemand::parser parser_;
   std::string scratch_;
 };

@@ -1,5 +1,7 @@
 #include "io/json_decoder.hpp"
 
+#include <cstring>
+
 namespace rvc::io {
 
 using simdjson::ondemand::json_type;
@@ -29,6 +31,16 @@ const char* expected_for(const spec::FieldTest& t) {
   return "a value";
 }
 
+// Raw JSON key == name (no escapes in name)? Keys are short: a byte loop
+// beats a call to memcmp.
+inline bool key_is(simdjson::ondemand::raw_json_string raw, const std::string& name) {
+  const char* k = reinterpret_cast<const char*>(raw.raw());
+  const size_t n = name.size();
+  for (size_t i = 0; i < n; ++i)
+    if (k[i] != name[i]) return false;
+  return k[n] == '"';
+}
+
 }  // namespace
 
 JsonDecoder::JsonDecoder(const engine::AtomTable& atoms, DecoderOptions options)
@@ -41,6 +53,73 @@ JsonDecoder::JsonDecoder(const engine::AtomTable& atoms, DecoderOptions options)
     if (tests[id].op == FOp::Present) presence_tests_.push_back(static_cast<int>(id));
   }
   if (options_.need_time) child(root_, options_.time_field)->is_time = true;
+  prepare(root_);
+}
+
+void JsonDecoder::remember(KeyNode& node, size_t position, simdjson::ondemand::raw_json_string raw,
+                           KeyNode* target) {
+  // The raw key runs up to its closing quote (escaped quotes are preceded by a backslash).
+  const char* k = reinterpret_cast<const char*>(raw.raw());
+  size_t n = 0;
+  while (k[n] != '"' || (n > 0 && k[n - 1] == '\\')) ++n;
+  if (node.by_position.size() <= position) node.by_position.resize(position + 1);
+  if (position > 64 || n > 64) return;  // odd messages: don't let the cache grow
+  node.by_position[position] = KeyNode::Seen{std::string(k, n), target};
+}
+
+void JsonDecoder::prepare(KeyNode& node) {
+  for (KeyNode& c : node.children) prepare(c);
+  for (KeyNode& c : node.children) node.any_escaped_child = node.any_escaped_child || !c.raw_comparable;
+  node.raw_comparable = node.name.find_first_of("\"\\") == std::string::npos;
+  if (node.tests.empty() || !node.children.empty() || node.is_time) return;
+  bool all_bool = true, all_number = true;
+  for (int id : node.tests) {
+    const spec::FieldTest& t = atoms_.tests()[id];
+    bool lit_bool = t.value.kind == spec::Literal::Kind::Bool, lit_num = t.value.kind == spec::Literal::Kind::Number;
+    bool is_bool = t.op == FOp::Truthy || t.op == FOp::Present || ((t.op == FOp::Eq || t.op == FOp::Ne) && lit_bool);
+    bool is_num = t.op == FOp::Present || ((t.op == FOp::Eq || t.op == FOp::Ne) && lit_num) || t.op == FOp::Lt ||
+                  t.op == FOp::Le || t.op == FOp::Gt || t.op == FOp::Ge;
+    all_bool = all_bool && is_bool;
+    all_number = all_number && is_num;
+    if (is_bool) {
+      uint8_t on_true = 1, on_false = 0;  // Truthy, Eq true, Ne false
+      if (t.op == FOp::Present) on_false = 1;
+      else if ((t.op == FOp::Eq && !t.value.b) || (t.op == FOp::Ne && t.value.b)) on_true = 0, on_false = 1;
+      node.bool_tests.push_back({id, on_true, on_false});
+    }
+  }
+  node.kind = all_bool ? Kind::Bool : all_number ? Kind::Number : Kind::General;
+}
+
+// Returns false when the value is not of the expected type: the caller then
+// takes the general path, which handles (and reports) every other case.
+__attribute__((always_inline)) inline bool JsonDecoder::fast_path(KeyNode& node, simdjson::ondemand::value& value) {
+  if (node.kind == Kind::Bool) {
+    bool b;
+    if (value.get_bool().get(b)) return false;
+    uint8_t* out = next_.data();
+    for (const BoolTest *t = node.bool_tests.data(), *end = t + node.bool_tests.size(); t != end; ++t)
+      out[t->id] = b ? t->if_true : t->if_false;
+    return true;
+  }
+  double d;
+  if (value.get_double().get(d)) return false;
+  for (int id : node.tests) {
+    const spec::FieldTest& t = atoms_.tests()[id];
+    const double x = t.value.number;
+    uint8_t r = 1;
+    switch (t.op) {
+      case FOp::Eq: r = d == x; break;
+      case FOp::Ne: r = d != x; break;
+      case FOp::Lt: r = d < x; break;
+      case FOp::Le: r = d <= x; break;
+      case FOp::Gt: r = d > x; break;
+      case FOp::Ge: r = d >= x; break;
+      default: break;  // Present
+    }
+    next_[id] = r;
+  }
+  return true;
 }
 
 JsonDecoder::KeyNode* JsonDecoder::child(KeyNode& parent, const std::string& name) {
@@ -51,9 +130,10 @@ JsonDecoder::KeyNode* JsonDecoder::child(KeyNode& parent, const std::string& nam
 }
 
 bool JsonDecoder::decode(simdjson::ondemand::object object, std::string& error, std::vector<std::string>* warnings) {
-  next_ = current_;
+  std::memcpy(next_.data(), current_.data(), current_.size());
   for (int id : presence_tests_) next_[id] = 0;
   saw_time_ = false;
+  malformed_ = false;
   ++generation_;
   if (!decode_object(object, root_, error, warnings)) return false;
   if (options_.need_time && !saw_time_) {
@@ -67,27 +147,53 @@ bool JsonDecoder::decode(simdjson::ondemand::object object, std::string& error, 
 
 bool JsonDecoder::decode_object(simdjson::ondemand::object object, KeyNode& node, std::string& error,
                                 std::vector<std::string>* warnings) {
-  for (auto field : object) {
-    std::string_view key;
-    if (auto err = field.unescaped_key().get(key)) {
+  size_t position = 0;
+  for (auto field_result : object) {
+    simdjson::ondemand::field field;
+    if (auto err = std::move(field_result).get(field)) {
       error = std::string("invalid JSON: ") + simdjson::error_message(err);
+      malformed_ = true;
       return false;
     }
+    // Compare the raw key bytes (no unescaping, no copy); names that contain
+    // a quote or backslash fall back to comparing the unescaped key.
+    simdjson::ondemand::raw_json_string raw = field.key();
     KeyNode* target = nullptr;
-    for (KeyNode& c : node.children)
-      if (c.name == key) { target = &c; break; }
-    if (!target) continue;  // fields no test reads are skipped by the iterator, unparsed
-    simdjson::ondemand::value value;
-    if (auto err = field.value().get(value)) {
-      error = std::string("invalid JSON: ") + simdjson::error_message(err);
-      return false;
+    bool known = false;
+    if (position < node.by_position.size()) {
+      const auto& seen = node.by_position[position];
+      if (key_is(raw, seen.key)) {
+        target = seen.target;
+        known = true;
+      }
     }
+    if (!known) {
+      for (KeyNode& c : node.children) {
+        if (c.raw_comparable && key_is(raw, c.name)) { target = &c; break; }
+      }
+      if (!target && node.any_escaped_child) {
+        std::string_view key;
+        if (auto err = field.unescaped_key().get(key)) {
+          error = std::string("invalid JSON: ") + simdjson::error_message(err);
+          malformed_ = true;
+          return false;
+        }
+        for (KeyNode& c : node.children)
+          if (!c.raw_comparable && c.name == key) { target = &c; break; }
+      }
+      remember(node, position, raw, target);
+    }
+    ++position;
+    if (!target) continue;  // fields no test reads are skipped by the iterator, unparsed
+    simdjson::ondemand::value value = field.value();
+    target->seen = generation_;
+    if (target->kind != Kind::General && fast_path(*target, value)) continue;
     json_type type;
     if (auto err = value.type().get(type)) {
       error = std::string("invalid JSON: ") + simdjson::error_message(err);
+      malformed_ = true;
       return false;
     }
-    target->seen = generation_;
     if (target->is_time && &node == &root_) {
       double t;
       if (type != json_type::number || value.get_double().get(t)) {
@@ -102,6 +208,7 @@ bool JsonDecoder::decode_object(simdjson::ondemand::object object, KeyNode& node
       simdjson::ondemand::object inner;
       if (auto err = value.get_object().get(inner)) {
         error = std::string("invalid JSON: ") + simdjson::error_message(err);
+      malformed_ = true;
         return false;
       }
       if (!decode_object(inner, *target, error, warnings)) return false;
@@ -125,6 +232,7 @@ bool JsonDecoder::apply_tests(KeyNode& node, simdjson::ondemand::value value, js
   else if (type == json_type::string) err = value.get_string().get(s);
   if (err) {
     error = std::string("invalid JSON value for field \"") + node.name + "\": " + simdjson::error_message(err);
+    malformed_ = true;
     return false;
   }
   for (int id : node.tests) {

@@ -33,6 +33,9 @@ class JsonDecoder {
   // must be rejected, leaving the committed values untouched. Warnings about
   // fields that kept their previous value are appended to `warnings`.
   bool decode(simdjson::ondemand::object object, std::string& error, std::vector<std::string>* warnings = nullptr);
+  // After decode() returned false: whether the JSON itself was malformed
+  // (rather than valid JSON that the properties cannot use).
+  bool malformed() const { return malformed_; }
   // Makes the last successful decode current.
   void commit() { current_.swap(next_); }
 
@@ -40,13 +43,35 @@ class JsonDecoder {
   double time() const { return time_; }
 
  private:
+  // Fast paths: most fields are tested only as Booleans or only as numbers;
+  // those read their value with one typed call and no per-test type checks.
+  enum class Kind : uint8_t { Bool, Number, General };
+  struct BoolTest {  // result = value ? if_true : if_false
+    int id;
+    uint8_t if_true, if_false;
+  };
   struct KeyNode {
     std::string name;
     std::vector<int> tests;          // atom ids testing this field
     std::vector<KeyNode> children;   // nested fields (a.b.c)
     bool is_time = false;
+    bool raw_comparable = true;      // name has no quote/backslash: compare raw JSON key bytes
+    bool any_escaped_child = false;  // some child needs the unescaped-key comparison
+    // Messages of one topic list their fields in the same order, so each
+    // field position remembers the key it saw last time and what it matched
+    // (nullptr: a field no test reads). One comparison confirms the guess.
+    struct Seen {
+      std::string key;
+      KeyNode* target;
+    };
+    std::vector<Seen> by_position;
+    Kind kind = Kind::General;
+    std::vector<BoolTest> bool_tests;
     uint32_t seen = 0;               // message generation when last present (strict mode)
   };
+  void prepare(KeyNode& node);
+  static void remember(KeyNode& node, size_t position, simdjson::ondemand::raw_json_string raw, KeyNode* target);
+  bool fast_path(KeyNode& node, simdjson::ondemand::value& value);
   KeyNode* child(KeyNode& parent, const std::string& name);
   bool decode_object(simdjson::ondemand::object object, KeyNode& node, std::string& error,
                      std::vector<std::string>* warnings);
@@ -61,6 +86,7 @@ class JsonDecoder {
   std::vector<uint8_t> current_, next_;
   double time_ = 0, next_time_ = 0;
   bool saw_time_ = false;
+  bool malformed_ = false;
   uint32_t generation_ = 0;
 };
 

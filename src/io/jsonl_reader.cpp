@@ -10,6 +10,19 @@
 namespace rvc::io {
 namespace {
 
+// Newlines in [begin, end): memchr is vectorized, std::count on bytes is not.
+uint64_t count_newlines(const char* begin, const char* end) {
+  uint64_t n = 0;
+  while (begin < end) {
+    const char* nl = static_cast<const char*>(std::memchr(begin, '\n', static_cast<size_t>(end - begin)));
+    if (!nl) break;
+    ++n;
+    begin = nl + 1;
+  }
+  return n;
+}
+
+
 using simdjson::ondemand::json_type;
 
 bool blank(std::string_view s) {
@@ -18,56 +31,64 @@ bool blank(std::string_view s) {
 
 class ChunkProcessor {
  public:
-  ChunkProcessor(JsonlHandler& handler) : handler_(handler) {}
+  ChunkProcessor(JsonlHandler& handler, size_t max_line) : handler_(handler), max_line_(max_line) {}
 
   // buf[0, len) holds complete lines (the last ends with '\n' unless at EOF);
   // buf has SIMDJSON_PADDING readable bytes after len.
   void process(const char* buf, size_t len, uint64_t first_line) {
     if (len == 0) return;
-    size_t resume = 0;  // where line-by-line mode starts, if needed
-    bool fallback = false;
-    simdjson::ondemand::document_stream stream;
-    if (stream_parser_.iterate_many(buf, len, std::max<size_t>(len, 1 << 16)).get(stream)) {
-      fallback = true;
-    } else {
-      uint64_t line = first_line;
-      size_t scanned = 0;  // newlines counted up to here
-      for (auto it = stream.begin(); it != stream.end(); ++it) {
-        size_t at = it.current_index();
-        std::string_view src = it.source();
-        // One JSON-lines record per line: a document that spans a newline, or
-        // anything the stream reports as an error, sends us to line mode.
-        if (it.error() || std::memchr(src.data(), '\n', src.size()) != nullptr) {
-          resume = at;
-          fallback = true;
+    size_t fast_len = len;  // the fast path reads buf[0, fast_len)
+    // With a message-size limit below the chunk size, a long line may sit
+    // inside the chunk: the fast path stops before it, line mode reports it.
+    if (max_line_ < len) {
+      for (size_t start = 0; start < len;) {
+        const char* nl = static_cast<const char*>(std::memchr(buf + start, '\n', len - start));
+        size_t end = nl ? static_cast<size_t>(nl - buf) : len;
+        if (end - start > max_line_) {
+          fast_len = start;
           break;
         }
-        line += static_cast<uint64_t>(std::count(buf + scanned, buf + at, '\n'));
-        scanned = at;
-        simdjson::ondemand::object object;
-        auto doc = *it;
-        if (doc.get_object().get(object)) {
-          resume = at;
-          fallback = true;
-          break;
-        }
-        handler_.on_object(line, object);
-      }
-      if (!fallback && stream.truncated_bytes() > 0) {
-        resume = len - stream.truncated_bytes();
-        fallback = true;
+        start = end + 1;
       }
     }
-    if (!fallback) return;
+    size_t resume = fast_len;  // where line-by-line mode starts
+    simdjson::ondemand::document_stream stream;
+    if (fast_len > 0) {
+      if (stream_parser_.iterate_many(buf, fast_len, std::max<size_t>(fast_len, 1 << 16)).get(stream)) {
+        resume = 0;
+      } else {
+        cache_at_ = buf;
+        cache_line_ = first_line;
+        for (auto it = stream.begin(); it != stream.end(); ++it) {
+          size_t at = it.current_index();
+          simdjson::ondemand::object object;
+          auto doc = *it;
+          if (it.error() || doc.get_object().get(object)) {
+            resume = at;
+            break;
+          }
+          if (!handler_.on_object(Position(buf, at, first_line, &cache_at_, &cache_line_), object)) {
+            resume = at;
+            break;
+          }
+        }
+        if (resume == fast_len && stream.truncated_bytes() > 0) resume = fast_len - stream.truncated_bytes();
+      }
+    }
+    if (resume >= len) return;
     // Line mode from the start of the line holding `resume`.
     while (resume > 0 && buf[resume - 1] != '\n') --resume;
-    uint64_t line = first_line + static_cast<uint64_t>(std::count(buf, buf + resume, '\n'));
+    uint64_t line = first_line + count_newlines(buf, buf + resume);
     size_t pos = resume;
     while (pos < len) {
       const char* nl = static_cast<const char*>(std::memchr(buf + pos, '\n', len - pos));
       size_t end = nl ? static_cast<size_t>(nl - buf) : len;
       std::string_view text(buf + pos, end - pos);
-      if (!blank(text)) parse_one(line_parser_, text, line, handler_, scratch_);
+      if (text.size() > max_line_)
+        handler_.on_error(LineError{line, 0, "message longer than " + std::to_string(max_line_) +
+                                                 " bytes (--max-message-size); skipped"});
+      else if (!blank(text))
+        parse_one(line_parser_, text, line, handler_, scratch_);
       pos = end + 1;
       ++line;
     }
@@ -75,11 +96,26 @@ class ChunkProcessor {
 
  private:
   JsonlHandler& handler_;
+  size_t max_line_;
+  const char* cache_at_ = nullptr;
+  uint64_t cache_line_ = 0;
   simdjson::ondemand::parser stream_parser_, line_parser_;
   std::string scratch_;
 };
 
 }  // namespace
+
+uint64_t Position::number() const {
+  if (!base_) return number_;
+  const char* at = base_ + offset_;
+  if (*cache_at_ > at || *cache_at_ < base_) {  // positions only move forward within a chunk
+    *cache_at_ = base_;
+    *cache_line_ = number_;
+  }
+  *cache_line_ += count_newlines(*cache_at_, at);
+  *cache_at_ = at;
+  return *cache_line_;
+}
 
 void parse_one(simdjson::ondemand::parser& parser, std::string_view text, uint64_t line, JsonlHandler& handler,
                std::string& scratch) {
@@ -106,8 +142,9 @@ void parse_one(simdjson::ondemand::parser& parser, std::string_view text, uint64
     return;
   }
   if (type != json_type::object) {
-    handler.on_error(LineError{line, 1, "expected a JSON object, got a JSON " +
-                                            std::string(type == json_type::array ? "array" : "scalar")});
+    std::string shown(text.substr(0, 40));
+    if (text.size() > 40) shown += "...";
+    handler.on_error(LineError{line, 1, "expected a JSON object {...}, found: " + shown});
     return;
   }
   simdjson::ondemand::object object;
@@ -115,11 +152,11 @@ void parse_one(simdjson::ondemand::parser& parser, std::string_view text, uint64
     fail("invalid JSON", err);
     return;
   }
-  handler.on_object(line, object);
+  if (!handler.on_object(Position(line), object)) handler.on_error(LineError{line, 0, handler.json_error()});
 }
 
 bool read_jsonl(int fd, JsonlHandler& handler, const ReaderOptions& options, std::string& error) {
-  ChunkProcessor processor(handler);
+  ChunkProcessor processor(handler, options.max_line_bytes);
   const size_t cap = std::max(options.chunk_bytes, options.max_line_bytes + 1);
   // simdjson may read SIMDJSON_PADDING bytes past what it parses; the slack
   // keeps that inside our buffer (its content does not matter).
@@ -156,7 +193,7 @@ bool read_jsonl(int fd, JsonlHandler& handler, const ReaderOptions& options, std
     }
     if (complete > 0) {
       processor.process(buf.data(), complete, line);
-      line += static_cast<uint64_t>(std::count(buf.data(), buf.data() + complete, '\n'));
+      line += static_cast<uint64_t>(count_newlines(buf.data(), buf.data() + complete));
       std::memmove(buf.data(), buf.data() + complete, have - complete);
       have -= complete;
     }

@@ -3,9 +3,12 @@
 //
 // Fast path: each chunk of complete lines goes through simdjson's document
 // stream (one SIMD pass over many messages). If a chunk holds anything odd (a
-// malformed line, a document spanning lines), the rest of that chunk is
-// re-read line by line, so a bad line costs only itself: every valid line
-// around it is still delivered, and the error names the line and column.
+// malformed line), the rest of that chunk is re-read line by line, so a bad
+// line costs only itself: every valid line around it is still delivered, and
+// the error names the line and column. Line numbers are counted only when an
+// error or warning asks for one. (Like simdjson's NDJSON support, the fast
+// path accepts any whitespace between documents, so a pretty-printed object
+// spanning lines is read as one message.)
 #pragma once
 
 #include <simdjson.h>
@@ -21,11 +24,33 @@ struct LineError {
   std::string message;
 };
 
+// Where a message came from: a line of a file (counted only when asked) or a
+// number given by the transport (a sequence number).
+class Position {
+ public:
+  explicit Position(uint64_t number) : number_(number) {}
+  Position(const char* base, size_t offset, uint64_t first_line, const char** cache_at, uint64_t* cache_line)
+      : number_(first_line), base_(base), offset_(offset), cache_at_(cache_at), cache_line_(cache_line) {}
+  uint64_t number() const;
+
+ private:
+  uint64_t number_;
+  const char* base_ = nullptr;
+  size_t offset_ = 0;
+  const char** cache_at_ = nullptr;  // last position counted in this chunk
+  uint64_t* cache_line_ = nullptr;
+};
+
 class JsonlHandler {
  public:
   virtual ~JsonlHandler() = default;
-  virtual void on_object(uint64_t line, simdjson::ondemand::object object) = 0;
+  // Returns false if the object turned out to be malformed JSON while being
+  // read (simdjson parses lazily); nothing of it may have been used. The
+  // reader then re-reads that stretch line by line and reports the error.
+  virtual bool on_object(const Position& position, simdjson::ondemand::object object) = 0;
   virtual void on_error(const LineError& error) = 0;
+  // The JSON error behind the last `false` from on_object.
+  virtual std::string json_error() const { return "invalid JSON"; }
 };
 
 struct ReaderOptions {

@@ -20,9 +20,26 @@ class Monitor {
   Step now() const { return now_; }  // index of the next step
 
  private:
-  std::vector<Instr> code_;
+  // Operands are slots of one value array: the atoms' values first, then the
+  // constants 0 and 1, then each operator's output. Atoms, constants and
+  // negations are not operators at all: `not` is a flag on the operand that
+  // reads it. A Timescales property shrinks from 12 nodes to 6 this way.
+  struct Op {
+    Code code;
+    uint8_t negate_a = 0, negate_b = 0;
+    uint8_t unused = 0;
+    uint16_t a = 0, b = 0;  // operand slots
+    uint16_t out = 0;       // result slot
+    uint16_t slot = 0;      // index into the state array of its operator
+  };
+  struct Operand {
+    uint16_t slot;
+    uint8_t negate;
+  };
+  std::vector<Op> ops_;
   std::vector<uint8_t> value_;
-  std::vector<int32_t> state_;  // per instruction: index into its operator's state array
+  size_t atom_count_ = 0;
+  Operand root_{};
   std::vector<Pre> pre_;
   std::vector<Once> once_;
   std::vector<Historically> historically_;

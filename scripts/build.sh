@@ -1,0 +1,7 @@
+#!/usr/bin/env bash
+# Configures and builds rvc with the release preset (2 parallel jobs).
+# Extra arguments go to the configure step, e.g. -DRVC_WITH_ZENOH=OFF.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+cmake --preset release "$@" >/dev/null
+cmake --build --preset release

@@ -1,0 +1,58 @@
+#!/usr/bin/env bash
+# Installs what rvc needs on Debian bookworm, by package name, from the
+# registries this project may use: Debian packages, PyPI, crates.io (cargo
+# fetches the Zenoh crate at build time). Idempotent: a second run is fast.
+set -euo pipefail
+
+SUDO=""
+if [ "$(id -u)" != 0 ]; then SUDO="sudo"; fi
+
+APT_PACKAGES=(
+  build-essential cmake ninja-build pkg-config git
+  libsimdjson-dev libcli11-dev libyaml-cpp-dev libgtest-dev libgmock-dev libbenchmark-dev
+  libsqlite3-dev
+  cyclonedds-dev cyclonedds-tools
+  python3 python3-pip
+  iproute2 time
+)
+# Zenoh is a Rust crate: any cargo >= 1.75 works; Debian's cargo-web (1.96)
+# is used when the machine has none.
+need_rust=1
+if command -v cargo >/dev/null 2>&1; then
+  v=$(cargo --version | awk '{print $2}')
+  if [ "$(printf '%s\n1.75.0\n' "$v" | sort -V | head -n1)" = "1.75.0" ]; then need_rust=0; fi
+fi
+if [ "$need_rust" = 1 ]; then APT_PACKAGES+=(rustc-web cargo-web); fi
+
+missing=()
+for p in "${APT_PACKAGES[@]}"; do
+  dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p")
+done
+if [ "${#missing[@]}" -gt 0 ]; then
+  echo "install-deps: apt packages: ${missing[*]}"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+
+# Python test oracles and peers: Reelay (the reference monitors), the official
+# Zenoh binding, CycloneDDS's Python binding, rosbags (ROS 2 CDR), pytest.
+PY=${PYTHON:-python3}
+PIP_PACKAGES=(pytest "reelay==25.0.0" "eclipse-zenoh==1.10.2" "cyclonedds==11.0.1" "rosbags==0.11.9" matplotlib)
+if ! "$PY" - "${PIP_PACKAGES[@]}" <<'PYEOF' 2>/dev/null
+import sys
+from importlib.metadata import version, PackageNotFoundError
+for spec in sys.argv[1:]:
+    name, _, want = spec.partition("==")
+    try:
+        got = version(name)
+    except PackageNotFoundError:
+        sys.exit(1)
+    if want and got != want:
+        sys.exit(1)
+PYEOF
+then
+  echo "install-deps: pip packages: ${PIP_PACKAGES[*]}"
+  "$PY" -m pip install -q "${PIP_PACKAGES[@]}" 2>/dev/null ||
+    "$PY" -m pip install -q --break-system-packages "${PIP_PACKAGES[@]}"
+fi
+echo "install-deps: ok"

@@ -1,0 +1,125 @@
+// rvc replay: publish a JSON-lines trace, one message per line, with
+// sequence numbers and an end-of-stream marker, at a fixed rate or as fast as
+// the (reliable) transport accepts. Waits for subscribers first, so nothing
+// sent before discovery completes is lost.
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <thread>
+
+#include "cli/commands.hpp"
+#include "cli/signals.hpp"
+#include "transport/transport_options.hpp"
+
+namespace rvc::cli {
+namespace {
+
+struct ReplayCommand {
+  transport::TransportOptions transports;
+  std::string file;
+  std::string to;
+  std::string rate = "max";
+  size_t wait_subscribers = 1;
+  double wait_timeout = 10;
+  bool no_eos = false;
+  bool progress = true;
+
+  int run() {
+    double hz = 0;
+    if (rate != "max") {
+      try {
+        hz = std::stod(rate);
+      } catch (...) {
+        hz = -1;
+      }
+      if (!(hz > 0)) {
+        std::fprintf(stderr, "rvc: --rate must be a positive number of messages per second or 'max', not '%s'\n",
+                     rate.c_str());
+        return kUsage;
+      }
+    }
+    std::FILE* in = file == "-" ? stdin : std::fopen(file.c_str(), "r");
+    if (!in) {
+      std::fprintf(stderr, "rvc: cannot open '%s'\n", file.c_str());
+      return kUsage;
+    }
+    long total_bytes = 0;
+    if (in != stdin && std::fseek(in, 0, SEEK_END) == 0) {
+      total_bytes = std::ftell(in);
+      std::rewind(in);
+    }
+    auto sink = transport::open_sink(to, transports);
+    install_stop_signals();
+    if (wait_subscribers > 0) {
+      std::fprintf(stderr, "rvc replay: waiting for %zu subscriber%s on %s ...\n", wait_subscribers,
+                   wait_subscribers == 1 ? "" : "s", to.c_str());
+      if (!sink->wait_matched(wait_subscribers, std::chrono::milliseconds(static_cast<long>(wait_timeout * 1000)))) {
+        std::fprintf(stderr, "rvc: no subscriber matched on %s within %.1f s (--wait-timeout; --wait-subscribers 0 to not wait)\n",
+                     to.c_str(), wait_timeout);
+        return kUsage;
+      }
+    }
+    const bool show = progress && isatty(2);
+    char* line = nullptr;
+    size_t cap = 0;
+    ssize_t n;
+    uint64_t seq = 0;
+    long bytes = 0;
+    auto t0 = std::chrono::steady_clock::now();
+    auto next_progress = t0;
+    while (!stop_requested() && (n = ::getline(&line, &cap, in)) >= 0) {
+      bytes += n;
+      size_t len = static_cast<size_t>(n);
+      while (len > 0 && (line[len - 1] == '\n' || line[len - 1] == '\r')) --len;
+      if (len == 0) continue;
+      ++seq;
+      if (hz > 0) std::this_thread::sleep_until(t0 + std::chrono::duration<double>(static_cast<double>(seq - 1) / hz));
+      sink->put(std::string_view(line, len), seq);
+      if (show && (seq & 1023) == 0) {
+        auto now = std::chrono::steady_clock::now();
+        if (now >= next_progress) {
+          next_progress = now + std::chrono::milliseconds(200);
+          double s = std::chrono::duration<double>(now - t0).count();
+          if (total_bytes > 0)
+            std::fprintf(stderr, "\r  %5.1f%%  %llu messages  %.0f msg/s   ", 100.0 * bytes / total_bytes,
+                         static_cast<unsigned long long>(seq), seq / s);
+          else
+            std::fprintf(stderr, "\r  %llu messages  %.0f msg/s   ", static_cast<unsigned long long>(seq), seq / s);
+        }
+      }
+    }
+    std::free(line);
+    if (in != stdin) std::fclose(in);
+    if (!no_eos) sink->put_eos(seq);
+    sink->flush();
+    double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (show) std::fprintf(stderr, "\r%60s\r", "");
+    std::fprintf(stderr, "rvc replay: sent %llu messages in %.3f s (%.0f msg/s) to %s\n",
+                 static_cast<unsigned long long>(seq), s, s > 0 ? seq / s : 0.0, to.c_str());
+    std::printf("{\"sent\":%llu,\"seconds\":%.6f,\"msgs_per_s\":%.1f}\n", static_cast<unsigned long long>(seq), s,
+                s > 0 ? seq / s : 0.0);
+    return kOk;
+  }
+};
+
+}  // namespace
+
+Runner register_replay(CLI::App& app) {
+  auto cmd = std::make_shared<ReplayCommand>();
+  CLI::App* sub = app.add_subcommand("replay", "Publish a JSON-lines trace to an endpoint, one message per line");
+  sub->add_option("file", cmd->file, "Trace (JSON lines), or - for stdin")->required();
+  sub->add_option("--to", cmd->to, "Endpoint: zenoh:KEYEXPR, dds:TOPIC, file:PATH")->required();
+  sub->add_option("--rate", cmd->rate, "Messages per second, or max")->capture_default_str();
+  sub->add_option("--wait-subscribers", cmd->wait_subscribers, "Subscribers to wait for before publishing")
+      ->capture_default_str();
+  sub->add_option("--wait-timeout", cmd->wait_timeout, "Seconds to wait for them")->capture_default_str();
+  sub->add_flag("--no-eos", cmd->no_eos, "Do not send the end-of-stream marker");
+  sub->add_flag("!--no-progress", cmd->progress, "No progress line on a terminal");
+  transport::add_transport_options(*sub, cmd->transports);
+  return [cmd] { return cmd->run(); };
+}
+
+}  // namespace rvc::cli

@@ -1,0 +1,40 @@
+// Options of every transport compiled in, registered on a subcommand so that
+// `rvc monitor`, `rvc replay` and `rvc perf` take the same flags.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include <memory>
+#include <string>
+
+#include "transport/endpoint.hpp"
+#ifdef RVC_HAVE_ZENOH
+#include "transport/zenoh/zenoh_options.hpp"
+#endif
+#ifdef RVC_HAVE_DDS
+#include "transport/dds/dds_options.hpp"
+#endif
+
+namespace rvc::transport {
+
+struct TransportOptions {
+#ifdef RVC_HAVE_ZENOH
+  ZenohOptions zenoh;
+#endif
+#ifdef RVC_HAVE_DDS
+  DdsOptions dds;
+#endif
+};
+
+void add_transport_options(CLI::App& app, TransportOptions& options);
+
+// Endpoint URIs: file:PATH | PATH | - | zenoh:KEYEXPR | dds:TOPIC.
+// Throw std::invalid_argument naming the problem (unknown scheme, a transport
+// not compiled in, an empty key expression).
+std::unique_ptr<Source> open_source(const std::string& uri, const TransportOptions& options);
+std::unique_ptr<Sink> open_sink(const std::string& uri, const TransportOptions& options);
+
+// "zenoh", "dds" or "file".
+std::string scheme_of(const std::string& uri);
+
+}  // namespace rvc::transport

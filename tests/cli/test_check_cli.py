@@ -1,0 +1,136 @@
+"""`rvc check` end to end: exit codes, error messages with positions, and
+that bad input never costs a valid message. Expected values are hand-computed."""
+import json
+import subprocess
+
+
+def run(rvc, *args, stdin=None):
+    return subprocess.run([rvc, *args], input=stdin, capture_output=True, text=True)
+
+
+def verdicts(stdout):
+    return [(v["time"], v["property"], v["value"]) for v in map(json.loads, stdout.splitlines())]
+
+
+def write(tmp_path, name, lines):
+    p = tmp_path / name
+    p.write_text("".join(l + "\n" for l in lines))
+    return str(p)
+
+
+def test_condensed_verdicts_and_exit_status(rvc, tmp_path):
+    trace = write(tmp_path, "t.jsonl", ['{"p":true}', '{"p":true}', '{"p":false}', '{"p":true}'])
+    r = run(rvc, "check", "--spec", "historically[:1]{p}", trace)
+    # H[:1] p over T,T,F,T: T,T,F,F -> changes at 0 (true) and 2 (false)
+    assert verdicts(r.stdout) == [(0, "p1", True), (2, "p1", False)]
+    assert r.returncode == 1
+    r = run(rvc, "check", "--all", "--spec", "once{p}", trace)
+    assert verdicts(r.stdout) == [(i, "p1", True) for i in range(4)]
+    assert r.returncode == 0
+
+
+def test_stdin_and_many_properties(rvc):
+    r = run(rvc, "check", "--spec", "{a}", "--spec", "pre {a}", "-", stdin='{"a":true}\n{"a":false}\n')
+    assert verdicts(r.stdout) == [(0, "p1", True), (0, "p2", False), (1, "p1", False), (1, "p2", True)]
+
+
+def test_properties_file_yaml_and_json(rvc, tmp_path):
+    trace = write(tmp_path, "t.jsonl", ['{"speed": 10}', '{"speed": 30}'])
+    y = tmp_path / "props.yaml"
+    y.write_text("properties:\n  - name: slow\n    spec: '{speed < 20}'\n  - name: fast\n    spec: '{speed > 20}'\n")
+    r = run(rvc, "check", "--properties", str(y), trace)
+    assert verdicts(r.stdout) == [(0, "slow", True), (0, "fast", False), (1, "slow", False), (1, "fast", True)]
+    j = tmp_path / "props.json"
+    j.write_text(json.dumps({"slow": "{speed < 20}"}))
+    r = run(rvc, "check", "--properties", str(j), trace)
+    assert verdicts(r.stdout) == [(0, "slow", True), (1, "slow", False)]
+
+
+def test_bad_spec_points_at_the_column(rvc, tmp_path):
+    trace = write(tmp_path, "t.jsonl", ['{"p":true}'])
+    r = run(rvc, "check", "--spec", "once[:2 {p}", trace)
+    assert r.returncode == 2
+    assert "column 9" in r.stderr and "expected ']'" in r.stderr
+    lines = r.stderr.splitlines()
+    caret = lines[-1]
+    source = lines[-2]
+    assert source.strip() == "once[:2 {p}"
+    assert caret.index("^") - source.index("o") == 8   # under '{', the 9th character
+    assert r.stdout == ""
+
+
+def test_malformed_lines_are_reported_and_valid_ones_kept(rvc, tmp_path):
+    trace = write(tmp_path, "t.jsonl", [
+        '{"p":true}',          # line 1
+        '{"p":',               # line 2: truncated
+        'not json',            # line 3
+        '[1, 2]',              # line 4: not an object
+        '',                    # line 5: blank, ignored
+        '{"p":false}',         # line 6
+        '{"p":"yes"}',         # line 7: wrong type -> warning, keeps false
+        '{"p":true}',          # line 8
+    ])
+    r = run(rvc, "check", "--all", "--spec", "{p}", trace)
+    # valid messages: lines 1, 6, 7, 8 -> steps 0..3 with p = T, F, F(kept), T; {p} fails at step 1
+    assert [v for _, _, v in verdicts(r.stdout)] == [True, False, False, True]
+    assert r.returncode == 1
+    assert "found: not json" in r.stderr
+    for n in (2, 3, 4):
+        assert f"line {n}" in r.stderr
+    assert "line 7" in r.stderr and "keeps its previous value" in r.stderr
+    assert "line 5" not in r.stderr and "line 6" not in r.stderr
+
+
+def test_exit_status_prefers_violation_over_rejects(rvc, tmp_path):
+    trace = write(tmp_path, "t.jsonl", ['{"p":true}', 'oops', '{"p":false}'])
+    r = run(rvc, "check", "--spec", "{p}", trace)
+    assert r.returncode == 1
+    trace = write(tmp_path, "u.jsonl", ['{"p":true}', 'oops', '{"p":true}'])
+    r = run(rvc, "check", "--spec", "{p}", trace)
+    assert r.returncode == 3 and "line 2" in r.stderr
+
+
+def test_dense_time_order_errors(rvc, tmp_path):
+    trace = write(tmp_path, "t.jsonl", [
+        '{"time": 0, "p": true}',
+        '{"time": 2, "p": false}',
+        '{"time": 1, "p": true}',   # line 3: goes back in time
+        '{"time": 2, "p": true}',   # line 4: not after 2
+        '{"p": true}',              # line 5: no time
+        '{"time": 5, "p": true}',
+        '{"time": 7}',
+    ])
+    r = run(rvc, "check", "--dense", "--spec", "{p}", trace)
+    # p: T on [0,2), F on [2,5), T on [5,7)
+    assert verdicts(r.stdout) == [(0, "p1", True), (2, "p1", False), (5, "p1", True)]
+    assert "line 3" in r.stderr and "not after the previous" in r.stderr
+    assert "line 4" in r.stderr and "line 5" in r.stderr and "missing time field" in r.stderr
+
+
+def test_strict_mode_rejects_missing_fields(rvc, tmp_path):
+    trace = write(tmp_path, "t.jsonl", ['{"p":true,"q":1}', '{"p":false}', '{"q":2,"p":true}'])
+    r = run(rvc, "check", "--all", "--spec", "{p} and {q > 0}", trace)
+    assert [v for _, _, v in verdicts(r.stdout)] == [True, False, True]   # q held at 1
+    r = run(rvc, "check", "--all", "--strict", "--spec", "{p} and {q > 0}", trace)
+    assert [v for _, _, v in verdicts(r.stdout)] == [True, True]          # line 2 rejected
+    assert 'line 2: missing field "q"' in r.stderr and r.returncode == 3
+
+
+def test_oversized_message_is_skipped(rvc, tmp_path):
+    big = '{"p": false, "pad": "' + "x" * 5000 + '"}'
+    trace = write(tmp_path, "t.jsonl", ['{"p":true}', big, '{"p":true}'])
+    r = run(rvc, "check", "--all", "--max-message-size", "1000", "--spec", "{p}", trace)
+    assert [v for _, _, v in verdicts(r.stdout)] == [True, True]
+    assert "line 2" in r.stderr and "longer than 1000" in r.stderr
+
+
+def test_unreadable_trace(rvc, tmp_path):
+    r = run(rvc, "check", "--spec", "{p}", str(tmp_path / "nope.jsonl"))
+    assert r.returncode == 2 and "nope.jsonl" in r.stderr
+
+
+def test_timescales_is_deterministic(rvc):
+    a = run(rvc, "timescales", "RespondGLB", "--ubound", "100", "--duration", "5000", "--seed", "9").stdout
+    b = run(rvc, "timescales", "RespondGLB", "--ubound", "100", "--duration", "5000", "--seed", "9").stdout
+    c = run(rvc, "timescales", "RespondGLB", "--ubound", "100", "--duration", "5000", "--seed", "10").stdout
+    assert a == b and a != c and len(a.splitlines()) == 5000
