@@ -7,9 +7,11 @@ def rvc_binary():
     path = os.environ.get("RVC_BIN")
     if path:
         return path
-    here = os.path.dirname(os.path.abspath(__file__))
+    root = os.path.dirname(os.path.abspath(__file__))
+    while root != "/" and not os.path.exists(os.path.join(root, "CMakePresets.json")):
+        root = os.path.dirname(root)
     for preset in ("release", "core", "debug"):
-        candidate = os.path.join(here, "..", "..", "build", preset, "rvc")
+        candidate = os.path.join(root, "build", preset, "rvc")
         if os.path.exists(candidate):
             return os.path.abspath(candidate)
     found = shutil.which("rvc")
