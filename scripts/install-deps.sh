@@ -15,12 +15,12 @@ APT_PACKAGES=(
   python3 python3-pip
   iproute2 time
 )
-# Zenoh is a Rust crate: any cargo >= 1.75 works; Debian's cargo-web (1.96)
+# Zenoh is a Rust crate: the locked Zenoh dependencies need cargo >= 1.89; Debian's cargo-web (1.96)
 # is used when the machine has none.
 need_rust=1
 if command -v cargo >/dev/null 2>&1; then
   v=$(cargo --version | awk '{print $2}')
-  if [ "$(printf '%s\n1.75.0\n' "$v" | sort -V | head -n1)" = "1.75.0" ]; then need_rust=0; fi
+  if [ "$(printf '%s\n1.89.0\n' "$v" | sort -V | head -n1)" = "1.89.0" ]; then need_rust=0; fi
 fi
 if [ "$need_rust" = 1 ]; then APT_PACKAGES+=(rustc-web cargo-web); fi
 

@@ -28,17 +28,26 @@ struct MonitorCommand {
   bool exit_on_eos = false;
   double stats_interval = 0;
   size_t queue_capacity = 1 << 14;
+  double first_at = 0;  // wall clock when the first message arrived
+
+  // Wall-clock seconds (shared by processes on one host): benchmarks compute
+  // "first publish to last verdict" from replay's started_at and our done_at.
+  static double wall_now() {
+    return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+  }
 
   std::string stats_json(const transport::SeqCounters& c, const Pipeline& p, uint64_t verdicts, bool eos) const {
-    char buf[512];
+    char buf[640];
     std::snprintf(buf, sizeof buf,
                   "{\"input\":\"%s\",\"received\":%llu,\"checked\":%llu,\"rejected\":%llu,\"gaps\":%llu,"
-                  "\"duplicates\":%llu,\"last_seq\":%llu,\"verdicts\":%llu,\"violations\":%llu,\"eos\":%s}",
+                  "\"duplicates\":%llu,\"last_seq\":%llu,\"verdicts\":%llu,\"violations\":%llu,\"eos\":%s,"
+                  "\"first_at\":%.6f,\"done_at\":%.6f}",
                   input.c_str(), static_cast<unsigned long long>(c.received),
                   static_cast<unsigned long long>(p.stats().accepted), static_cast<unsigned long long>(p.stats().rejected),
                   static_cast<unsigned long long>(c.gaps), static_cast<unsigned long long>(c.duplicates),
                   static_cast<unsigned long long>(c.last_seq), static_cast<unsigned long long>(verdicts),
-                  static_cast<unsigned long long>(p.checker().violations()), eos ? "true" : "false");
+                  static_cast<unsigned long long>(p.checker().violations()), eos ? "true" : "false", first_at,
+                  wall_now());
     return buf;
   }
 
@@ -75,14 +84,18 @@ struct MonitorCommand {
     size_t count = 0;
     bool eos = false;
     auto last_stats = std::chrono::steady_clock::now();
-    auto publish_stats = [&](bool final_report) {
+    auto publish_stats = [&]() {
       std::string js = stats_json(counters, pipeline, verdicts, eos);
       std::fprintf(stderr, "%s\n", js.c_str());
       if (stats_sink) stats_sink->put(js, 0);
-      (void)final_report;
     };
     while (!stop_requested() && !(eos && exit_on_eos)) {
       if (!queue.pop_batch(batch, count, 100)) break;
+      if (count == 0) {
+        for (auto& s : sinks) s->idle();
+        continue;
+      }
+      if (count > 0 && first_at == 0) first_at = wall_now();
       for (size_t i = 0; i < count; ++i) {
         const transport::OwnedFrame& f = batch[i];
         if (f.eos) {
@@ -93,23 +106,27 @@ struct MonitorCommand {
         counters.on_seq(f.seq);
         pipeline.feed(f.payload, f.seq ? f.seq : counters.received);
       }
-      if (stats_requested()) publish_stats(false);
+      if (stats_requested()) publish_stats();
       if (stats_interval > 0 &&
           std::chrono::steady_clock::now() - last_stats > std::chrono::duration<double>(stats_interval)) {
         last_stats = std::chrono::steady_clock::now();
-        publish_stats(false);
+        publish_stats();
       }
     }
-    source->stop();
-    queue.close();
     for (auto& s : sinks) {
       s->put_eos(verdicts);
       s->flush();
     }
-    pipeline.finish_report();
     counters.rejected = pipeline.stats().rejected;
-    publish_stats(true);
-    if (stats_sink) stats_sink->flush();
+    std::string final_stats = stats_json(counters, pipeline, verdicts, eos);  // done_at: last verdict out
+    source->stop();
+    queue.close();
+    pipeline.finish_report();
+    std::fprintf(stderr, "%s\n", final_stats.c_str());
+    if (stats_sink) {
+      stats_sink->put(final_stats, 0);
+      stats_sink->flush();
+    }
     if (pipeline.violated()) return kViolated;
     if (counters.gaps > 0 || counters.duplicates > 0) return kLost;
     return pipeline.stats().rejected > 0 ? kBadInput : kOk;

@@ -4,7 +4,11 @@
 // sent before discovery completes is lost.
 #include <unistd.h>
 
+#include <algorithm>
+#include <atomic>
 #include <chrono>
+#include <mutex>
+#include <vector>
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -26,6 +30,11 @@ struct ReplayCommand {
   double wait_timeout = 10;
   bool no_eos = false;
   bool progress = true;
+  std::string latency_from;  // verdict endpoint of a monitor run with --all: measure publish -> verdict
+
+  static double wall_now() {
+    return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+  }
 
   int run() {
     double hz = 0;
@@ -53,6 +62,25 @@ struct ReplayCommand {
     }
     auto sink = transport::open_sink(to, transports);
     install_stop_signals();
+    // Latency: with `rvc monitor --all`, verdict k answers message k. We note
+    // when each message left and when its verdict came back.
+    std::vector<std::chrono::steady_clock::time_point> sent_at;
+    std::vector<double> latency_us;
+    std::mutex latency_mutex;
+    std::atomic<uint64_t> verdicts_back{0};
+    std::unique_ptr<transport::Source> echo;
+    if (!latency_from.empty()) {
+      sent_at.reserve(1 << 20);
+      echo = transport::open_source(latency_from, transports);
+      echo->start([&](const transport::Frame& f) {
+        if (f.eos) return;
+        auto now = std::chrono::steady_clock::now();
+        uint64_t k = ++verdicts_back;
+        std::lock_guard<std::mutex> lock(latency_mutex);
+        if (k <= sent_at.size())
+          latency_us.push_back(std::chrono::duration<double, std::micro>(now - sent_at[k - 1]).count());
+      });
+    }
     if (wait_subscribers > 0) {
       std::fprintf(stderr, "rvc replay: waiting for %zu subscriber%s on %s ...\n", wait_subscribers,
                    wait_subscribers == 1 ? "" : "s", to.c_str());
@@ -69,6 +97,7 @@ struct ReplayCommand {
     uint64_t seq = 0;
     long bytes = 0;
     auto t0 = std::chrono::steady_clock::now();
+    const double started_at = wall_now();
     auto next_progress = t0;
     while (!stop_requested() && (n = ::getline(&line, &cap, in)) >= 0) {
       bytes += n;
@@ -77,6 +106,10 @@ struct ReplayCommand {
       if (len == 0) continue;
       ++seq;
       if (hz > 0) std::this_thread::sleep_until(t0 + std::chrono::duration<double>(static_cast<double>(seq - 1) / hz));
+      if (echo) {
+        std::lock_guard<std::mutex> lock(latency_mutex);
+        sent_at.push_back(std::chrono::steady_clock::now());
+      }
       sink->put(std::string_view(line, len), seq);
       if (show && (seq & 1023) == 0) {
         auto now = std::chrono::steady_clock::now();
@@ -99,8 +132,25 @@ struct ReplayCommand {
     if (show) std::fprintf(stderr, "\r%60s\r", "");
     std::fprintf(stderr, "rvc replay: sent %llu messages in %.3f s (%.0f msg/s) to %s\n",
                  static_cast<unsigned long long>(seq), s, s > 0 ? seq / s : 0.0, to.c_str());
-    std::printf("{\"sent\":%llu,\"seconds\":%.6f,\"msgs_per_s\":%.1f}\n", static_cast<unsigned long long>(seq), s,
-                s > 0 ? seq / s : 0.0);
+    std::string latency;
+    if (echo) {
+      auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+      while (verdicts_back < seq && std::chrono::steady_clock::now() < deadline)
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      echo->stop();
+      std::lock_guard<std::mutex> lock(latency_mutex);
+      std::sort(latency_us.begin(), latency_us.end());
+      auto pct = [&](double q) {
+        return latency_us.empty() ? 0.0 : latency_us[std::min(latency_us.size() - 1, static_cast<size_t>(q * latency_us.size()))];
+      };
+      char buf[256];
+      std::snprintf(buf, sizeof buf,
+                    ",\"verdicts_back\":%zu,\"latency_us\":{\"p50\":%.1f,\"p90\":%.1f,\"p99\":%.1f,\"max\":%.1f}",
+                    latency_us.size(), pct(0.5), pct(0.9), pct(0.99), latency_us.empty() ? 0.0 : latency_us.back());
+      latency = buf;
+    }
+    std::printf("{\"sent\":%llu,\"seconds\":%.6f,\"msgs_per_s\":%.1f,\"started_at\":%.6f%s}\n",
+                static_cast<unsigned long long>(seq), s, s > 0 ? seq / s : 0.0, started_at, latency.c_str());
     return kOk;
   }
 };
@@ -118,6 +168,8 @@ Runner register_replay(CLI::App& app) {
   sub->add_option("--wait-timeout", cmd->wait_timeout, "Seconds to wait for them")->capture_default_str();
   sub->add_flag("--no-eos", cmd->no_eos, "Do not send the end-of-stream marker");
   sub->add_flag("!--no-progress", cmd->progress, "No progress line on a terminal");
+  sub->add_option("--latency-from", cmd->latency_from,
+                  "Verdict endpoint of an `rvc monitor --all`: report publish-to-verdict latency percentiles");
   transport::add_transport_options(*sub, cmd->transports);
   return [cmd] { return cmd->run(); };
 }

@@ -23,6 +23,9 @@ Runner register_check(CLI::App& app);
 Runner register_timescales(CLI::App& app);
 Runner register_monitor(CLI::App& app);
 Runner register_replay(CLI::App& app);
-Runner register_router(CLI::App& app);  // only with the Zenoh transport
+Runner register_router(CLI::App& app);      // only with the Zenoh transport
+Runner register_dds_config(CLI::App& app);  // only with the DDS transport
+Runner register_perf(CLI::App& app);
+Runner register_bridge(CLI::App& app);
 
 }  // namespace rvc::cli

@@ -18,8 +18,13 @@ int main(int argc, char** argv) {
   runners["timescales"] = register_timescales(app);
   runners["monitor"] = register_monitor(app);
   runners["replay"] = register_replay(app);
+  runners["perf"] = register_perf(app);
+  runners["bridge"] = register_bridge(app);
 #ifdef RVC_HAVE_ZENOH
   runners["router"] = register_router(app);
+#endif
+#ifdef RVC_HAVE_DDS
+  runners["dds-config"] = register_dds_config(app);
 #endif
   try {
     app.parse(argc, argv);

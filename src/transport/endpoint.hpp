@@ -36,6 +36,9 @@ class Sink {
   // Waits until at least n subscribers match; false on timeout.
   virtual bool wait_matched(size_t n, std::chrono::milliseconds timeout) { return true; }
   virtual void flush() {}
+  // Called by long-running loops when no message is pending: a chance to make
+  // buffered output visible (files) without a write per message.
+  virtual void idle() {}
 };
 
 }  // namespace rvc::transport

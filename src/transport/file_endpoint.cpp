@@ -59,8 +59,12 @@ void FileSink::put(std::string_view payload, uint64_t) {
   std::fwrite(payload.data(), 1, payload.size(), file_);
   std::fputc('\n', file_);
   if (line_buffered_) std::fflush(file_);
+  else dirty_ = true;
 }
 
-void FileSink::flush() { std::fflush(file_); }
+void FileSink::flush() {
+  std::fflush(file_);
+  dirty_ = false;
+}
 
 }  // namespace rvc::transport

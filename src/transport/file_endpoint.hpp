@@ -33,9 +33,13 @@ class FileSink final : public Sink {
   void put(std::string_view payload, uint64_t seq) override;
   void put_eos(uint64_t last_seq) override { flush(); }
   void flush() override;
+  void idle() override {
+    if (dirty_) flush();
+  }
 
  private:
   std::FILE* file_ = nullptr;
+  bool dirty_ = false;
   bool owned_ = false;
   bool line_buffered_ = false;
 };

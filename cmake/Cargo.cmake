@@ -1,0 +1,67 @@
+# Cargo.cmake: build a Rust staticlib with cargo as part of the CMake build.
+#
+#   rvc_cargo_staticlib(<target>
+#     MANIFEST_DIR <dir with Cargo.toml and Cargo.lock>
+#     LIB_NAME     <[lib] name in Cargo.toml, e.g. rvc_zenoh>)
+#
+# Defines <target>, an INTERFACE library that links the resulting
+# lib<LIB_NAME>.a plus the system libraries a Rust std staticlib needs on
+# Linux (what `rustc --print native-static-libs` lists), and orders the cargo
+# build before anything that links it.
+#
+# Always --release (the crate is a dependency, not something we debug) and
+# --locked (Cargo.lock is committed: builds are reproducible and never
+# silently resolve new versions). CARGO_TARGET_DIR lives in the build tree so
+# compiled dependencies survive between builds of the same tree; cargo's
+# parallelism follows RVC_CARGO_JOBS (default 2, the size of our machines).
+#
+# Ninja reruns cargo only when a file under src/, Cargo.toml or Cargo.lock
+# changes (the stamp below); cargo then does its own fine-grained check.
+
+include_guard(GLOBAL)
+
+set(RVC_CARGO_JOBS 2 CACHE STRING "Parallel jobs for cargo builds")
+
+find_program(CARGO_EXECUTABLE cargo
+  HINTS "$ENV{CARGO_HOME}/bin" "$ENV{HOME}/.cargo/bin"
+  DOC "cargo, to build the Rust parts of rvc")
+
+function(rvc_cargo_staticlib target)
+  cmake_parse_arguments(ARG "" "MANIFEST_DIR;LIB_NAME" "" ${ARGN})
+  if(NOT ARG_MANIFEST_DIR OR NOT ARG_LIB_NAME)
+    message(FATAL_ERROR "rvc_cargo_staticlib(${target}): MANIFEST_DIR and LIB_NAME are required")
+  endif()
+  if(NOT CARGO_EXECUTABLE)
+    message(FATAL_ERROR
+      "cargo not found: install a Rust toolchain (rustup or Debian's cargo), "
+      "or configure with -DRVC_WITH_ZENOH=OFF")
+  endif()
+
+  get_filename_component(manifest_dir "${ARG_MANIFEST_DIR}" ABSOLUTE)
+  set(target_dir "${CMAKE_BINARY_DIR}/cargo-target")
+  set(lib "${target_dir}/release/lib${ARG_LIB_NAME}.a")
+  set(stamp "${CMAKE_CURRENT_BINARY_DIR}/${target}.cargo-stamp")
+
+  file(GLOB_RECURSE sources CONFIGURE_DEPENDS
+    "${manifest_dir}/src/*.rs" "${manifest_dir}/build.rs")
+
+  add_custom_command(
+    OUTPUT "${stamp}"
+    BYPRODUCTS "${lib}"
+    COMMAND "${CMAKE_COMMAND}" -E env
+            "CARGO_TARGET_DIR=${target_dir}" "CARGO_BUILD_JOBS=${RVC_CARGO_JOBS}"
+            "${CARGO_EXECUTABLE}" build --locked --release -j ${RVC_CARGO_JOBS}
+            --manifest-path "${manifest_dir}/Cargo.toml"
+    COMMAND "${CMAKE_COMMAND}" -E touch "${stamp}"
+    DEPENDS ${sources} "${manifest_dir}/Cargo.toml" "${manifest_dir}/Cargo.lock"
+    WORKING_DIRECTORY "${manifest_dir}"
+    COMMENT "cargo build --release ${ARG_LIB_NAME}"
+    VERBATIM)
+  add_custom_target(${target}_cargo DEPENDS "${stamp}")
+
+  add_library(${target} INTERFACE)
+  add_dependencies(${target} ${target}_cargo)
+  find_package(Threads REQUIRED)
+  target_link_libraries(${target} INTERFACE
+    "${lib}" Threads::Threads ${CMAKE_DL_LIBS} m rt util gcc_s)
+endfunction()

@@ -1,0 +1,61 @@
+#!/usr/bin/env bash
+# Builds the rvc image from deploy/docker/Dockerfile with the best builder this machine has:
+#   - BuildKit (buildx, or a pre-23 docker client with DOCKER_BUILDKIT=1): cache mounts for apt,
+#     the cargo registry and ccache persist between builds;
+#   - otherwise the legacy builder, fed the same Dockerfile with the RUN --mount flags removed.
+#
+#   deploy/docker/build.sh [--tag IMAGE] [--network host] [--no-cache] [--jobs N]
+#
+# Environment: RVC_IMAGE (default rvc:latest), RVC_DOCKER (docker client to use),
+# RVC_DOCKER_BUILDER=buildkit|legacy (force one). Prints one JSON line at the end:
+#   {"image":"rvc:latest","builder":"buildkit","seconds":312.4,"size_bytes":96123456}
+set -euo pipefail
+ROOT=$(cd "$(dirname "$0")/../.." && pwd)
+IMAGE=${RVC_IMAGE:-rvc:latest}
+JOBS=2
+extra=()
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --tag|-t) IMAGE=$2; shift 2 ;;
+    --network) extra+=(--network "$2"); shift 2 ;;
+    --no-cache) extra+=(--no-cache); shift ;;
+    --jobs) JOBS=$2; shift 2 ;;
+    -h|--help) sed -n '2,12p' "$0"; exit 0 ;;
+    *) echo "build.sh: unknown argument $1" >&2; exit 2 ;;
+  esac
+done
+
+"$ROOT/scripts/docker-setup.sh" --check || "$ROOT/scripts/docker-setup.sh"
+
+client_major() { "$1" version --format '{{.Client.Version}}' 2>/dev/null | cut -d. -f1; }
+pick_builder() {
+  local c
+  for c in ${RVC_DOCKER:-} docker /usr/bin/docker; do
+    command -v "$c" >/dev/null 2>&1 || continue
+    if [ "${RVC_DOCKER_BUILDER:-}" = legacy ]; then echo "legacy $c"; return; fi
+    if "$c" buildx version >/dev/null 2>&1; then echo "buildkit $c"; return; fi
+    local m; m=$(client_major "$c")
+    # Clients before 23.0 have BuildKit built in (DOCKER_BUILDKIT=1), later ones need buildx.
+    if [ -n "$m" ] && [ "$m" -lt 23 ]; then echo "buildkit $c"; return; fi
+  done
+  echo "legacy ${RVC_DOCKER:-docker}"
+}
+read -r builder client < <(pick_builder)
+if [ "${RVC_DOCKER_BUILDER:-}" = buildkit ] && [ "$builder" != buildkit ]; then
+  echo "build.sh: BuildKit requested but no client here supports it" >&2; exit 2
+fi
+
+cd "$ROOT"
+start=$(date +%s.%N)
+echo "build.sh: $builder builder ($client), image $IMAGE" >&2
+if [ "$builder" = buildkit ]; then
+  DOCKER_BUILDKIT=1 "$client" build --progress=plain -f deploy/docker/Dockerfile \
+    --build-arg JOBS="$JOBS" -t "$IMAGE" "${extra[@]}" .
+else
+  sed -E '/^ *#/!s/--mount=[^ ]+ *//g; /^ *\\$/d' deploy/docker/Dockerfile |
+    DOCKER_BUILDKIT=0 "$client" build -f - --build-arg JOBS="$JOBS" -t "$IMAGE" "${extra[@]}" .
+fi
+end=$(date +%s.%N)
+size=$("$client" image inspect -f '{{.Size}}' "$IMAGE")
+printf '{"image":"%s","builder":"%s","seconds":%.1f,"size_bytes":%s}\n' \
+  "$IMAGE" "$builder" "$(echo "$end - $start" | bc -l 2>/dev/null || python3 -c "print($end-$start)")" "$size"

@@ -1,0 +1,147 @@
+// rvc bridge FROM TO [FROM TO]...: forwards every message of one endpoint to
+// another, payload and sequence number unchanged, end-of-stream markers
+// included. The DDS -> Zenoh bridge of the baseline benchmark
+// (`rvc bridge dds:/rvc_perf zenoh:rvc_perf`), and its reverse for ping/pong.
+//
+// Each route is a Source whose handler publishes on a Sink, on the source's
+// transport thread: a reliable sink that blocks slows the source down, and
+// with reliable DDS/Zenoh that reaches the original publisher (no queue, no
+// loss, no copy beyond what the transports do).
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "cli/commands.hpp"
+#include "cli/signals.hpp"
+#include "transport/transport_options.hpp"
+
+namespace rvc::cli {
+namespace {
+
+struct Route {
+  std::string from, to;
+  std::unique_ptr<transport::Sink> sink;
+  std::unique_ptr<transport::Source> source;
+  std::atomic<uint64_t> forwarded{0};
+  std::atomic<uint64_t> eos_count{0};
+};
+
+std::string json_escape(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    if (c == '"' || c == '\\') out += '\\';
+    if (static_cast<unsigned char>(c) < 0x20) continue;
+    out += c;
+  }
+  return out;
+}
+
+struct BridgeCommand {
+  transport::TransportOptions transports;
+  std::vector<std::string> uris;
+  size_t wait_subscribers = 1;
+  double wait_timeout = 30;
+  bool exit_on_eos = false;
+  double stats_interval = 0;
+
+  int run() {
+    if (uris.size() < 2 || uris.size() % 2 != 0) {
+      std::fprintf(stderr, "rvc bridge: give endpoints in pairs: FROM TO [FROM TO]...\n");
+      return kUsage;
+    }
+    std::vector<std::unique_ptr<Route>> routes;
+    for (size_t i = 0; i < uris.size(); i += 2) {
+      if (uris[i] == uris[i + 1]) {
+        std::fprintf(stderr, "rvc bridge: route %s -> %s would feed itself\n", uris[i].c_str(), uris[i + 1].c_str());
+        return kUsage;
+      }
+      auto r = std::make_unique<Route>();
+      r->from = uris[i];
+      r->to = uris[i + 1];
+      routes.push_back(std::move(r));
+    }
+    install_stop_signals();
+    // Sinks first, and wait for their subscribers: a source that starts
+    // forwarding before the far side listens would lose the first messages.
+    for (auto& r : routes) {
+      r->sink = transport::open_sink(r->to, transports);
+      if (wait_subscribers > 0) {
+        std::fprintf(stderr, "rvc bridge: waiting for %zu subscriber%s on %s ...\n", wait_subscribers,
+                     wait_subscribers == 1 ? "" : "s", r->to.c_str());
+        if (!r->sink->wait_matched(wait_subscribers,
+                                   std::chrono::milliseconds(static_cast<long>(wait_timeout * 1000)))) {
+          std::fprintf(stderr, "rvc bridge: no subscriber matched on %s within %.1f s (--wait-timeout)\n",
+                       r->to.c_str(), wait_timeout);
+          return kUsage;
+        }
+      }
+    }
+    for (auto& r : routes) {
+      r->source = transport::open_source(r->from, transports);
+      Route* route = r.get();
+      r->source->start([route](const transport::Frame& f) {
+        if (f.eos) {
+          route->sink->put_eos(f.seq);
+          route->eos_count.fetch_add(1);
+          return;
+        }
+        route->sink->put(f.payload, f.seq);
+        route->forwarded.fetch_add(1, std::memory_order_relaxed);
+      });
+      std::fprintf(stderr, "rvc bridge: forwarding %s -> %s\n", r->from.c_str(), r->to.c_str());
+    }
+    std::fflush(stderr);
+    auto last = std::chrono::steady_clock::now();
+    while (!stop_requested()) {
+      if (exit_on_eos) {
+        bool all = true;
+        for (auto& r : routes) all = all && r->eos_count.load() > 0;
+        if (all) break;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      if (stats_interval > 0 &&
+          std::chrono::steady_clock::now() - last > std::chrono::duration<double>(stats_interval)) {
+        last = std::chrono::steady_clock::now();
+        for (auto& r : routes)
+          std::fprintf(stderr, "rvc bridge: %s -> %s forwarded %llu\n", r->from.c_str(), r->to.c_str(),
+                       static_cast<unsigned long long>(r->forwarded.load()));
+      }
+    }
+    for (auto& r : routes) r->source->stop();
+    for (auto& r : routes) r->sink->flush();
+    std::string js = "{\"routes\":[";
+    for (size_t i = 0; i < routes.size(); ++i) {
+      const Route& r = *routes[i];
+      js += (i ? "," : "");
+      js += "{\"from\":\"" + json_escape(r.from) + "\",\"to\":\"" + json_escape(r.to) +
+            "\",\"forwarded\":" + std::to_string(r.forwarded.load()) + ",\"eos\":" + std::to_string(r.eos_count.load()) +
+            "}";
+    }
+    js += "]}";
+    std::printf("%s\n", js.c_str());
+    return kOk;
+  }
+};
+
+}  // namespace
+
+Runner register_bridge(CLI::App& app) {
+  auto cmd = std::make_shared<BridgeCommand>();
+  CLI::App* sub = app.add_subcommand(
+      "bridge", "Forward messages between endpoints (e.g. dds:TOPIC -> zenoh:KEY), payload and seq unchanged");
+  sub->add_option("routes", cmd->uris, "FROM TO pairs: dds:TOPIC, zenoh:KEYEXPR, file:PATH")->required();
+  sub->add_option("--wait-subscribers", cmd->wait_subscribers,
+                  "Before forwarding, wait for this many subscribers on every TO (0 = do not wait)")
+      ->capture_default_str();
+  sub->add_option("--wait-timeout", cmd->wait_timeout, "Seconds to wait for them")->capture_default_str();
+  sub->add_flag("--exit-on-eos", cmd->exit_on_eos, "Exit once every route forwarded an end-of-stream marker");
+  sub->add_option("--stats-interval", cmd->stats_interval, "Print forwarded counts every S seconds (stderr)");
+  transport::add_transport_options(*sub, cmd->transports);
+  return [cmd] { return cmd->run(); };
+}
+
+}  // namespace rvc::cli

@@ -1,0 +1,36 @@
+// rvc dds-config: print the CycloneDDS XML that rvc's participants use, so
+// that other DDS programs on the host (ROS 2 nodes, ddsperf, Python
+// cyclonedds) can join the same loopback-pinned network through
+// CYCLONEDDS_URI=file://...
+#include <cstdio>
+#include <memory>
+#include <string>
+
+#include "cli/commands.hpp"
+#include "transport/dds/dds_options.hpp"
+
+namespace rvc::cli {
+
+Runner register_dds_config(CLI::App& app) {
+  struct Cmd {
+    transport::DdsOptions dds;
+    std::string output = "-";
+  };
+  auto cmd = std::make_shared<Cmd>();
+  CLI::App* sub = app.add_subcommand("dds-config", "Print the CycloneDDS XML rvc uses (for CYCLONEDDS_URI of other programs)");
+  transport::add_dds_options(*sub, cmd->dds);
+  sub->add_option("--output,-o", cmd->output, "File to write (- for stdout)")->capture_default_str();
+  return [cmd] {
+    std::string xml = transport::dds::generated_config_xml(cmd->dds);
+    std::FILE* out = cmd->output == "-" ? stdout : std::fopen(cmd->output.c_str(), "w");
+    if (!out) {
+      std::fprintf(stderr, "rvc: cannot write '%s'\n", cmd->output.c_str());
+      return static_cast<int>(kUsage);
+    }
+    std::fputs(xml.c_str(), out);
+    if (out != stdout) std::fclose(out);
+    return static_cast<int>(kOk);
+  };
+}
+
+}  // namespace rvc::cli

@@ -1,0 +1,42 @@
+// The Zenoh attachment rvc puts on every sample (docs/zenoh.md, "Attachment"):
+//
+//   offset 0..7  seq    uint64, little-endian (1-based; 0 = unknown)
+//   offset 8     flags  bit 0 = end of stream (payload empty, seq = last data seq)
+//                       bits 1..7 reserved, sent as 0, ignored on receipt
+//
+// Python: struct.pack("<QB", seq, flags). Receivers accept longer attachments
+// (extra bytes ignored, room for later fields) and treat shorter ones, or no
+// attachment at all, as seq 0 without flags, so plain publishers still work.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+
+namespace rvc::transport {
+
+inline constexpr std::size_t kSeqAttachmentSize = 9;
+inline constexpr std::uint8_t kSeqFlagEos = 0x01;
+
+struct SeqAttachment {
+  std::uint64_t seq = 0;
+  bool eos = false;
+};
+
+inline std::array<std::uint8_t, kSeqAttachmentSize> encode_seq_attachment(std::uint64_t seq,
+                                                                          bool eos = false) {
+  std::array<std::uint8_t, kSeqAttachmentSize> out{};
+  for (std::size_t i = 0; i < 8; ++i) out[i] = static_cast<std::uint8_t>(seq >> (8 * i));
+  out[8] = eos ? kSeqFlagEos : 0;
+  return out;
+}
+
+inline SeqAttachment decode_seq_attachment(const std::uint8_t* data, std::size_t len) {
+  SeqAttachment a;
+  if (data == nullptr || len < 8) return a;
+  for (std::size_t i = 0; i < 8; ++i) a.seq |= static_cast<std::uint64_t>(data[i]) << (8 * i);
+  if (len >= kSeqAttachmentSize) a.eos = (data[8] & kSeqFlagEos) != 0;
+  return a;
+}
+
+}  // namespace rvc::transport

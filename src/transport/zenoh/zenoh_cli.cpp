@@ -1,0 +1,35 @@
+// Command-line flags for Zenoh endpoints (CLI11). Kept apart from the
+// transport code so only the CLI pulls in CLI11's headers.
+#include <CLI/CLI.hpp>
+
+#include "transport/zenoh/zenoh_options.hpp"
+
+namespace rvc::transport {
+
+void add_zenoh_options(CLI::App& app, ZenohOptions& o) {
+  const std::string group = "Zenoh";
+  app.add_option("--mode", o.mode, "Zenoh mode: peer, client or router (default peer)")
+      ->check(CLI::IsMember({"peer", "client", "router"}))
+      ->each([&o](const std::string&) { o.mode_explicit = true; })
+      ->group(group);
+  app.add_option("--connect", o.connect,
+                 "Zenoh endpoint to connect to, e.g. tcp/127.0.0.1:7447 (repeatable, comma list)")
+      ->delimiter(',')
+      ->group(group);
+  app.add_option("--listen", o.listen,
+                 "Zenoh endpoint to listen on (repeatable, comma list; default tcp/127.0.0.1:0 "
+                 "for peers, tcp/127.0.0.1:7447 for routers)")
+      ->delimiter(',')
+      ->group(group);
+  app.add_flag("--multicast-scouting,!--no-multicast-scouting", o.multicast_scouting,
+               "Discover peers by UDP multicast on the loopback interface (default off)")
+      ->group(group);
+  app.add_option("--zenoh-config", o.config_file,
+                 "Zenoh JSON5 config file; the flags above override it")
+      ->check(CLI::ExistingFile)
+      ->group(group);
+  app.add_flag("--express", o.express, "Publish each sample at once instead of batching")
+      ->group(group);
+}
+
+}  // namespace rvc::transport

@@ -1,0 +1,93 @@
+#include "transport/zenoh/zenoh_endpoint.hpp"
+
+#include <cstdio>
+#include <mutex>
+#include <stdexcept>
+#include <thread>
+#include <utility>
+
+#include "transport/zenoh/seq_attachment.hpp"
+
+namespace rvc::transport {
+
+// ---- ZenohSource -----------------------------------------------------------
+
+ZenohSource::ZenohSource(std::shared_ptr<ZenohSession> session, std::string keyexpr)
+    : session_(std::move(session)), keyexpr_(std::move(keyexpr)) {}
+
+ZenohSource::~ZenohSource() { stop(); }
+
+void ZenohSource::start(FrameHandler handler) {
+  if (sub_) throw std::logic_error("ZenohSource::start called twice");
+  // Zenoh may deliver from several threads at once (one per link); the seam
+  // promises a single transport thread's worth of calls, so serialise them.
+  auto on_sample = [handler = std::move(handler),
+                    mu = std::make_shared<std::mutex>()](const ZenohSample& s) {
+    const auto a = decode_seq_attachment(reinterpret_cast<const uint8_t*>(s.attachment.data()),
+                                         s.attachment.size());
+    Frame f;
+    f.seq = a.seq;
+    f.eos = a.eos;
+    if (!a.eos) f.payload = s.payload;  // an EOS marker carries no data
+    std::lock_guard lock(*mu);
+    handler(f);
+  };
+  // Announced, so a replayer waiting for n monitors can count this one.
+  sub_ = std::make_unique<ZenohSubscriber>(session_, keyexpr_, std::move(on_sample), true);
+}
+
+void ZenohSource::stop() {
+  if (sub_) sub_->undeclare();
+  sub_.reset();
+}
+
+// ---- ZenohSink -------------------------------------------------------------
+
+ZenohSink::ZenohSink(std::shared_ptr<ZenohSession> session, std::string keyexpr, bool express)
+    : session_(session), pub_(std::move(session), keyexpr, express) {}
+
+void ZenohSink::put(std::string_view payload, uint64_t seq) {
+  const auto att = encode_seq_attachment(seq, false);
+  pub_.put(payload, std::string_view(reinterpret_cast<const char*>(att.data()), att.size()));
+}
+
+void ZenohSink::put_eos(uint64_t last_seq) {
+  const auto att = encode_seq_attachment(last_seq, true);
+  pub_.put({}, std::string_view(reinterpret_cast<const char*>(att.data()), att.size()));
+}
+
+bool ZenohSink::wait_matched(size_t n, std::chrono::milliseconds timeout) {
+  return pub_.wait_matched(n, timeout);
+}
+
+// ---- factories ---------------------------------------------------------------
+
+std::unique_ptr<Source> make_zenoh_source(std::string keyexpr, const ZenohOptions& opts) {
+  return std::make_unique<ZenohSource>(ZenohSession::shared(opts), std::move(keyexpr));
+}
+
+std::unique_ptr<Sink> make_zenoh_sink(std::string keyexpr, const ZenohOptions& opts) {
+  return std::make_unique<ZenohSink>(ZenohSession::shared(opts), std::move(keyexpr), opts.express);
+}
+
+// ---- router ------------------------------------------------------------------
+
+int run_zenoh_router(const ZenohOptions& opts, std::atomic<bool>& stop) {
+  ZenohOptions o = opts;
+  o.mode = "router";
+  o.mode_explicit = true;
+  try {
+    auto session = ZenohSession::open(o);
+    const std::string listen = zenoh_config_json(o, "listen/endpoints");
+    std::fprintf(stderr, "rvc router: %s listening on %s\n", session->zid().c_str(),
+                 listen.c_str());
+    std::fflush(stderr);
+    while (!stop.load()) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    return 0;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "rvc router: %s\n", e.what());
+    return 1;
+  }
+}
+
+}  // namespace rvc::transport

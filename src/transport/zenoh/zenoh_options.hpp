@@ -1,0 +1,33 @@
+// How an rvc process joins a Zenoh network, as set on the command line.
+// Without a config file rvc's defaults keep everything on loopback: peers
+// listen on tcp/127.0.0.1:0, routers on tcp/127.0.0.1:7447, multicast
+// scouting is off. See docs/zenoh.md.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace CLI {
+class App;
+}
+
+namespace rvc::transport {
+
+struct ZenohOptions {
+  std::string mode = "peer";         // peer | client | router
+  std::vector<std::string> connect;  // endpoints such as tcp/127.0.0.1:7447
+  std::vector<std::string> listen;   // empty = default for the mode (see above)
+  // Off unless asked for, even when the config file enables it; when on, it
+  // is confined to the loopback interface.
+  bool multicast_scouting = false;
+  std::string config_file;  // JSON5 Zenoh config; explicit flags override it
+  // With a config file, its mode is kept unless --mode was given.
+  bool mode_explicit = false;
+  bool express = false;  // publishers: send each sample at once, no batching
+};
+
+// Registers --mode, --connect, --listen, --multicast-scouting /
+// --no-multicast-scouting, --zenoh-config FILE and --express on `app`.
+void add_zenoh_options(CLI::App& app, ZenohOptions& opts);
+
+}  // namespace rvc::transport
