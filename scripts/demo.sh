@@ -1,7 +1,10 @@
 #!/usr/bin/env bash
 # README command 1: install what is missing, build, and run the main job on
-# the embedded default (no containers, loopback only): generate a Timescales
-# trace and check its property, printing the verdicts.
+# the embedded default — no containers, loopback only:
+#   rvc timescales -> trace.jsonl
+#   rvc replay trace.jsonl --to zenoh:rv/timescales   (publisher)
+#   rvc monitor --input zenoh:rv/timescales --output zenoh:rv/verdicts --output file:verdicts.jsonl
+# then the same trace through `rvc check`, to show the verdicts are identical.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
@@ -10,28 +13,55 @@ RVC=build/release/rvc
 OUT=build/demo
 mkdir -p "$OUT"
 
-FAMILY=AlwaysBQR BOUND=100 STEPS=1000000
+FAMILY=AlwaysBQR BOUND=100 STEPS=200000
 echo
 echo "== rvc timescales $FAMILY --ubound $BOUND --duration $STEPS --seed 7"
 "$RVC" timescales "$FAMILY" --ubound $BOUND --duration $STEPS --seed 7 -o "$OUT/trace.jsonl" \
   --properties-out "$OUT/properties.yaml"
-head -n 3 "$OUT/trace.jsonl"
-echo "...   ($(wc -l < "$OUT/trace.jsonl") messages)"
-cat "$OUT/properties.yaml"
-
+head -n 2 "$OUT/trace.jsonl"
 # A second property that the trace violates, so there is something to see.
 cat >> "$OUT/properties.yaml" <<'YAML'
   - name: q_answered_quickly
     spec: "historically({r} -> once[:20]{q})"
 YAML
+cat "$OUT/properties.yaml"
+
+if "$RVC" router --help >/dev/null 2>&1; then
+  PORT=$(python3 -c 'import socket; s=socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
+  ZENOH_MON=(--mode peer --listen "tcp/127.0.0.1:$PORT" --no-multicast-scouting)
+  ZENOH_PUB=(--mode peer --connect "tcp/127.0.0.1:$PORT" --no-multicast-scouting)
+  echo
+  echo "== rvc monitor over Zenoh (peer-to-peer on tcp/127.0.0.1:$PORT, multicast scouting off)"
+  "$RVC" monitor --properties "$OUT/properties.yaml" --input zenoh:rv/timescales \
+    --output zenoh:rv/verdicts --output "file:$OUT/verdicts.jsonl" --exit-on-eos "${ZENOH_MON[@]}" \
+    2> "$OUT/monitor.log" &
+  MON=$!
+  trap 'kill $MON 2>/dev/null || true' EXIT
+  "$RVC" replay "$OUT/trace.jsonl" --to zenoh:rv/timescales --rate max "${ZENOH_PUB[@]}"
+  set +e
+  wait $MON
+  status=$?
+  set -e
+  trap - EXIT
+  echo "monitor counters: $(tail -n 1 "$OUT/monitor.log")"
+else
+  echo "(rvc was built without Zenoh: checking the file locally instead)"
+  set +e
+  "$RVC" check --properties "$OUT/properties.yaml" "$OUT/trace.jsonl" -o "$OUT/verdicts.jsonl"
+  status=$?
+  set -e
+fi
 echo
-echo "== rvc check --properties $OUT/properties.yaml $OUT/trace.jsonl --summary   (verdict changes only)"
+echo "== verdicts (changes only; $(wc -l < "$OUT/verdicts.jsonl") in $OUT/verdicts.jsonl)"
+head -n 8 "$OUT/verdicts.jsonl"
 set +e
-"$RVC" check --properties "$OUT/properties.yaml" "$OUT/trace.jsonl" --summary -o "$OUT/verdicts.jsonl"
-status=$?
-head -n 12 "$OUT/verdicts.jsonl"
-echo "...   ($(wc -l < "$OUT/verdicts.jsonl") verdict changes in $OUT/verdicts.jsonl)"
+"$RVC" check --properties "$OUT/properties.yaml" "$OUT/trace.jsonl" -o "$OUT/verdicts-local.jsonl"
 set -e
-echo
-echo "exit status $status (0: all properties held, 1: a property was violated)"
+if cmp -s "$OUT/verdicts.jsonl" "$OUT/verdicts-local.jsonl"; then
+  echo "== identical to \`rvc check\` on the same file"
+else
+  echo "== DIFFERENT from \`rvc check\` on the same file" >&2
+  exit 1
+fi
+echo "exit status $status (0: all properties held, 1: a property was violated, 4: messages lost)"
 [ "$status" -le 1 ]
