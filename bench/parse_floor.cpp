@@ -13,17 +13,17 @@ namespace {
 
 struct Floor final : rvc::io::JsonlHandler {
   uint64_t messages = 0, trues = 0, errors = 0;
-  bool on_object(const rvc::io::Position&, simdjson::ondemand::object object) override {
+  rvc::io::ReadResult on_object(const rvc::io::Position&, simdjson::ondemand::object object) override {
     ++messages;
     for (auto field : object) {
       std::string_view key;
-      if (field.unescaped_key().get(key)) return false;
+      if (field.unescaped_key().get(key)) return rvc::io::ReadResult::Malformed;
       simdjson::ondemand::value v;
-      if (field.value().get(v)) return false;
+      if (field.value().get(v)) return rvc::io::ReadResult::Malformed;
       bool b;
       if (!v.get_bool().get(b)) trues += b;
     }
-    return true;
+    return rvc::io::ReadResult::Pending;
   }
   void on_error(const rvc::io::LineError&) override { ++errors; }
 };

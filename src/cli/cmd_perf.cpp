@@ -32,6 +32,8 @@ struct PerfCommand {
       r.opts.rate = perf::parse_rate(r.rate);
       if (r.opts.duration < 0 || r.opts.timeout <= 0 || r.opts.idle_timeout <= 0)
         throw std::invalid_argument("--duration must be >= 0, --timeout and --idle-timeout > 0");
+      if (r.opts.write_batch && (r.opts.transport != "dds" || r.opts.rate > 0))
+        throw std::invalid_argument("--write-batch needs --transport dds and --rate max");
       if ((name == "pub" || name == "ping") && r.opts.duration <= 0)
         throw std::invalid_argument("rvc perf " + name + ": --duration must be > 0");
       install_stop_signals();
@@ -76,6 +78,9 @@ void add_role(PerfCommand& cmd, CLI::App& perf, const std::string& name, const s
     s->add_option("--idle-timeout", r.opts.idle_timeout, "Stop when nothing arrived for this many seconds")
         ->capture_default_str();
   }
+  if (name == "pub")
+    s->add_flag("--write-batch", r.opts.write_batch,
+                "DDS at max rate: CycloneDDS write batching (several samples per packet, as ddsperf does)");
   if (name == "ping")
     s->add_option("--warmup", r.opts.warmup, "Round trips sent in the first S seconds are not counted")
         ->capture_default_str();

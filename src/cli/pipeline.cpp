@@ -47,21 +47,29 @@ void Pipeline::on_error(const io::LineError& error) {
   report(where + ": " + error.message + " (message skipped)");
 }
 
-bool Pipeline::on_object(const io::Position& where, simdjson::ondemand::object object) {
+io::ReadResult Pipeline::on_object(const io::Position& where, simdjson::ondemand::object object) {
   std::string error;
   warnings_.clear();
   if (!decoder_.decode(object, error, &warnings_)) {
     if (decoder_.malformed()) {  // the reader re-reads this stretch and reports it
       json_error_ = error;
-      return false;
+      return io::ReadResult::Malformed;
     }
     on_error(io::LineError{where.number(), 0, error});
-    return true;
+    return io::ReadResult::Rejected;
   }
   for (const std::string& w : warnings_) {
     ++stats_.warnings;
     report("warning: " + options_.position_name + " " + std::to_string(where.number()) + ": " + w);
   }
+  pending_ = true;
+  pending_where_ = &where;  // valid until the reader calls commit() (same stack frame)
+  return io::ReadResult::Pending;
+}
+
+void Pipeline::commit() {
+  if (!pending_) return;
+  pending_ = false;
   if (options_.parse_only) {
     decoder_.commit();
   } else if (checker_.model() == engine::TimeModel::Discrete) {
@@ -75,8 +83,8 @@ bool Pipeline::on_object(const io::Position& where, simdjson::ondemand::object o
       std::string why = t < 0 ? "time " + number(t) + " is negative (the timeline starts at 0)"
                               : "time " + number(t) + " is not after the previous message's time " +
                                     number(last_time_) + " (dense time needs strictly increasing times)";
-      on_error(io::LineError{where.number(), 0, why});
-      return true;
+      on_error(io::LineError{pending_where_->number(), 0, why});
+      return;
     }
     checker_.step(begin, t, decoder_.values());
     decoder_.commit();
@@ -84,7 +92,6 @@ bool Pipeline::on_object(const io::Position& where, simdjson::ondemand::object o
     last_time_ = t;
   }
   ++stats_.accepted;
-  return true;
 }
 
 void Pipeline::feed(std::string_view payload, uint64_t position) {

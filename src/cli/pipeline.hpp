@@ -37,8 +37,10 @@ class Pipeline final : public io::JsonlHandler {
   Pipeline(const std::vector<engine::PropertySpec>& properties, const PipelineOptions& options,
            engine::VerdictCallback on_verdict);
 
-  bool on_object(const io::Position& position, simdjson::ondemand::object object) override;
+  io::ReadResult on_object(const io::Position& position, simdjson::ondemand::object object) override;
   std::string json_error() const override { return json_error_; }
+  void commit() override;
+  void discard() override { pending_ = false; }
   void on_error(const io::LineError& error) override;
   // One network payload; `position` names it in errors (its sequence number).
   void feed(std::string_view payload, uint64_t position);
@@ -56,6 +58,8 @@ class Pipeline final : public io::JsonlHandler {
   io::JsonDecoder decoder_;
   PipelineStats stats_;
   bool has_time_ = false;
+  bool pending_ = false;        // decoded, waiting for commit()
+  const io::Position* pending_where_ = nullptr;
   double last_time_ = 0;
   uint64_t reported_ = 0;
   std::vector<std::string> warnings_;

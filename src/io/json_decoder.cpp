@@ -31,6 +31,13 @@ const char* expected_for(const spec::FieldTest& t) {
   return "a value";
 }
 
+bool raw_has_backslash(simdjson::ondemand::raw_json_string raw) {
+  const char* k = reinterpret_cast<const char*>(raw.raw());
+  for (size_t i = 0; k[i] != '"' || (i > 0 && k[i - 1] == '\\'); ++i)
+    if (k[i] == '\\') return true;
+  return false;
+}
+
 // Raw JSON key == name (no escapes in name)? Keys are short: a byte loop
 // beats a call to memcmp.
 inline bool key_is(simdjson::ondemand::raw_json_string raw, const std::string& name) {
@@ -62,8 +69,10 @@ void JsonDecoder::remember(KeyNode& node, size_t position, simdjson::ondemand::r
   const char* k = reinterpret_cast<const char*>(raw.raw());
   size_t n = 0;
   while (k[n] != '"' || (n > 0 && k[n - 1] == '\\')) ++n;
-  if (node.by_position.size() <= position) node.by_position.resize(position + 1);
   if (position > 64 || n > 64) return;  // odd messages: don't let the cache grow
+  // A key with escapes must take the unescaping path every time.
+  if (std::memchr(k, '\\', n) != nullptr) return;
+  if (node.by_position.size() <= position) node.by_position.resize(position + 1, KeyNode::Seen{"\x01", nullptr});
   node.by_position[position] = KeyNode::Seen{std::string(k, n), target};
 }
 
@@ -171,7 +180,8 @@ bool JsonDecoder::decode_object(simdjson::ondemand::object object, KeyNode& node
       for (KeyNode& c : node.children) {
         if (c.raw_comparable && key_is(raw, c.name)) { target = &c; break; }
       }
-      if (!target && node.any_escaped_child) {
+      // A key written with escapes ("\u0070") is compared unescaped.
+      if (!target && (node.any_escaped_child || raw_has_backslash(raw))) {
         std::string_view key;
         if (auto err = field.unescaped_key().get(key)) {
           error = std::string("invalid JSON: ") + simdjson::error_message(err);
@@ -179,7 +189,7 @@ bool JsonDecoder::decode_object(simdjson::ondemand::object object, KeyNode& node
           return false;
         }
         for (KeyNode& c : node.children)
-          if (!c.raw_comparable && c.name == key) { target = &c; break; }
+          if (c.name == key) { target = &c; break; }
       }
       remember(node, position, raw, target);
     }

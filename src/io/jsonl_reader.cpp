@@ -29,6 +29,19 @@ bool blank(std::string_view s) {
   return std::all_of(s.begin(), s.end(), [](char c) { return c == ' ' || c == '\t' || c == '\r'; });
 }
 
+// Where a document that starts at `from` sits, given that the next one (or
+// the end of the parsed text) starts at `to`. JSON Lines means one object
+// per line: anything else is handled line by line, as line mode would.
+enum class Layout { OwnLine, SharesLine, SpansLines };
+
+Layout layout(const char* buf, size_t from, size_t to) {
+  const char* nl = static_cast<const char*>(std::memchr(buf + from, '\n', to - from));
+  if (!nl) return Layout::SharesLine;
+  for (const char* p = nl + 1; p < buf + to; ++p)
+    if (*p != ' ' && *p != '\t' && *p != '\r' && *p != '\n') return Layout::SpansLines;
+  return Layout::OwnLine;
+}
+
 class ChunkProcessor {
  public:
   ChunkProcessor(JsonlHandler& handler, size_t max_line) : handler_(handler), max_line_(max_line) {}
@@ -52,6 +65,7 @@ class ChunkProcessor {
       }
     }
     size_t resume = fast_len;  // where line-by-line mode starts
+    bool skip_resume_line = false;  // the line at `resume` held an object with junk after it
     simdjson::ondemand::document_stream stream;
     if (fast_len > 0) {
       if (stream_parser_.iterate_many(buf, fast_len, std::max<size_t>(fast_len, 1 << 16)).get(stream)) {
@@ -59,20 +73,55 @@ class ChunkProcessor {
       } else {
         cache_at_ = buf;
         cache_line_ = first_line;
+        // An object is committed only when the next document starts on a
+        // later line: "{...}}" or "{...} {...}" on one line is one bad line.
+        bool pending = false;
+        size_t pending_at = 0;
         for (auto it = stream.begin(); it != stream.end(); ++it) {
           size_t at = it.current_index();
+          if (pending) {
+            pending = false;
+            Layout l = layout(buf, pending_at, at);
+            if (l != Layout::OwnLine) {
+              handler_.discard();
+              resume = pending_at;
+              skip_resume_line = l == Layout::SharesLine;
+              break;
+            }
+            handler_.commit();
+          }
           simdjson::ondemand::object object;
           auto doc = *it;
           if (it.error() || doc.get_object().get(object)) {
             resume = at;
             break;
           }
-          if (!handler_.on_object(Position(buf, at, first_line, &cache_at_, &cache_line_), object)) {
+          ReadResult r = handler_.on_object(Position(buf, at, first_line, &cache_at_, &cache_line_), object);
+          if (r == ReadResult::Malformed) {
             resume = at;
             break;
           }
+          if (r == ReadResult::Pending) {
+            pending = true;
+            pending_at = at;
+          }
         }
-        if (resume == fast_len && stream.truncated_bytes() > 0) resume = fast_len - stream.truncated_bytes();
+        if (pending) {
+          const bool truncated = resume == fast_len && stream.truncated_bytes() > 0;
+          const size_t end = truncated ? fast_len - stream.truncated_bytes() : fast_len;
+          Layout l = layout(buf, pending_at, end);
+          if (!truncated && l == Layout::SharesLine) l = Layout::OwnLine;  // the last line may lack its newline
+          if (l == Layout::OwnLine) {
+            handler_.commit();
+            if (truncated) resume = end;
+          } else {
+            handler_.discard();
+            resume = pending_at;
+            skip_resume_line = l == Layout::SharesLine;
+          }
+        } else if (resume == fast_len && stream.truncated_bytes() > 0) {
+          resume = fast_len - stream.truncated_bytes();
+        }
       }
     }
     if (resume >= len) return;
@@ -80,6 +129,14 @@ class ChunkProcessor {
     while (resume > 0 && buf[resume - 1] != '\n') --resume;
     uint64_t line = first_line + count_newlines(buf, buf + resume);
     size_t pos = resume;
+    if (skip_resume_line) {
+      // An object followed by more text on its line ({"p":true}} or two
+      // objects on one line): the line is one bad message.
+      handler_.on_error(LineError{line, 0, "unexpected text after the JSON object"});
+      const char* nl = static_cast<const char*>(std::memchr(buf + pos, '\n', len - pos));
+      pos = nl ? static_cast<size_t>(nl - buf) + 1 : len;
+      ++line;
+    }
     while (pos < len) {
       const char* nl = static_cast<const char*>(std::memchr(buf + pos, '\n', len - pos));
       size_t end = nl ? static_cast<size_t>(nl - buf) : len;
@@ -108,6 +165,9 @@ class ChunkProcessor {
 uint64_t Position::number() const {
   if (!base_) return number_;
   const char* at = base_ + offset_;
+  // simdjson may report the first document of a chunk at offset 0 even when
+  // blank lines come first: the document starts at the first non-blank byte.
+  while (*at == ' ' || *at == '\t' || *at == '\r' || *at == '\n') ++at;
   if (*cache_at_ > at || *cache_at_ < base_) {  // positions only move forward within a chunk
     *cache_at_ = base_;
     *cache_line_ = number_;
@@ -123,10 +183,11 @@ void parse_one(simdjson::ondemand::parser& parser, std::string_view text, uint64
   scratch.assign(text.data(), text.size());
   scratch.append(simdjson::SIMDJSON_PADDING, '\0');
   simdjson::ondemand::document doc;
+  bool started = false;  // the document exists: its location can be asked for
   auto fail = [&](const char* what, simdjson::error_code err) {
     uint64_t column = 0;
     const char* loc = nullptr;
-    if (!doc.current_location().get(loc) && loc >= scratch.data() && loc <= scratch.data() + text.size())
+    if (started && !doc.current_location().get(loc) && loc >= scratch.data() && loc <= scratch.data() + text.size())
       column = static_cast<uint64_t>(loc - scratch.data()) + 1;
     std::string msg = std::string(what);
     if (err) msg += std::string(": ") + simdjson::error_message(err);
@@ -136,6 +197,7 @@ void parse_one(simdjson::ondemand::parser& parser, std::string_view text, uint64
     fail("invalid JSON", err);
     return;
   }
+  started = true;
   json_type type;
   if (auto err = doc.type().get(type)) {
     fail("invalid JSON", err);
@@ -152,7 +214,25 @@ void parse_one(simdjson::ondemand::parser& parser, std::string_view text, uint64
     fail("invalid JSON", err);
     return;
   }
-  if (!handler.on_object(Position(line), object)) handler.on_error(LineError{line, 0, handler.json_error()});
+  ReadResult r = handler.on_object(Position(line), object);
+  if (r == ReadResult::Malformed) {
+    handler.on_error(LineError{line, 0, handler.json_error()});
+    return;
+  }
+  if (r == ReadResult::Rejected) return;
+  // The handler iterated the whole object (skipping what it does not read),
+  // so anything left is text after the object.
+  // current_location() succeeds only while text remains (simdjson 3.0 has no at_end()).
+  const char* rest = nullptr;
+  if (!doc.current_location().get(rest)) {
+    handler.discard();
+    uint64_t column = 0;
+    if (rest >= scratch.data() && rest <= scratch.data() + text.size())
+      column = static_cast<uint64_t>(rest - scratch.data()) + 1;
+    handler.on_error(LineError{line, column, "unexpected text after the JSON object"});
+    return;
+  }
+  handler.commit();
 }
 
 bool read_jsonl(int fd, JsonlHandler& handler, const ReaderOptions& options, std::string& error) {

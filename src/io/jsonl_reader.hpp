@@ -6,9 +6,9 @@
 // malformed line), the rest of that chunk is re-read line by line, so a bad
 // line costs only itself: every valid line around it is still delivered, and
 // the error names the line and column. Line numbers are counted only when an
-// error or warning asks for one. (Like simdjson's NDJSON support, the fast
-// path accepts any whitespace between documents, so a pretty-printed object
-// spanning lines is read as one message.)
+// error or warning asks for one. One message is one line in both paths: an
+// object broken over lines is reported line by line, and an object with more
+// text after it on its line ({...}} or two objects) is one bad line.
 #pragma once
 
 #include <simdjson.h>
@@ -41,13 +41,26 @@ class Position {
   uint64_t* cache_line_ = nullptr;
 };
 
+// What a handler made of an object it read.
+enum class ReadResult {
+  Pending,    // fine so far: act on it at commit(), once the reader knows it is whole
+  Rejected,   // refused (and already reported) by the handler: valid JSON it cannot use
+  Malformed,  // the JSON broke while being read: the reader reports it (json_error())
+};
+
 class JsonlHandler {
  public:
   virtual ~JsonlHandler() = default;
-  // Returns false if the object turned out to be malformed JSON while being
-  // read (simdjson parses lazily); nothing of it may have been used. The
-  // reader then re-reads that stretch line by line and reports the error.
-  virtual bool on_object(const Position& position, simdjson::ondemand::object object) = 0;
+  // Reads the object, but must not act on it before commit(): simdjson parses
+  // lazily, so the reader only knows the message is whole (no broken or
+  // trailing text) after the handler has read it. Returns false if the
+  // object turned out to be malformed while being read; the reader then
+  // re-reads that stretch line by line and reports the error.
+  virtual ReadResult on_object(const Position& position, simdjson::ondemand::object object) = 0;
+  // The object just read (Pending) is whole: act on it.
+  virtual void commit() {}
+  // The object just read (Pending) had broken text after it: forget it.
+  virtual void discard() {}
   virtual void on_error(const LineError& error) = 0;
   // The JSON error behind the last `false` from on_object.
   virtual std::string json_error() const { return "invalid JSON"; }

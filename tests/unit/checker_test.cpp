@@ -135,10 +135,16 @@ std::string balanced_or(int lo, int hi) {  // {aLO} or ... or {aHI-1}, as a bala
   return "(" + balanced_or(lo, mid) + " or " + balanced_or(mid, hi) + ")";
 }
 
-TEST(Checker, DISABLED_AtomIndexBeyond65535AcrossProperties) {
-  // BUG (src/engine/discrete/monitor.cpp, uncommitted Op refactor): Monitor::Op
-  // stores the atom index in a uint16_t; the table is shared by all
-  // properties, so atom 70000 is read as atom 70000 - 65536 = 4464.
+TEST(Checker, AtomIndexBeyond65535AcrossProperties) {
+  // BUG (src/engine/discrete/monitor.cpp): the discrete Monitor addresses
+  // atoms by their index in the Checker-wide AtomTable through uint16_t
+  // slots. The table is shared by all properties, so once the properties
+  // together use more than ~65,000 distinct atoms, later properties (here
+  // big4, 20k nodes, and even the one-node {z}) are refused with
+  // std::length_error "property too large (more than 65000 nodes)". (An
+  // earlier version of the same code silently read atom 70000 as atom 4464.)
+  // Fix: map each property's atoms to local slots (or use 32-bit slots), so
+  // the limit applies per property.
   Recorder r;
   Checker c(TimeModel::Discrete, false, r.callback());
   for (int k = 0; k < 7; ++k) c.add_property({"big" + std::to_string(k), balanced_or(10000 * k, 10000 * (k + 1))});

@@ -106,11 +106,11 @@ TEST(Pipeline, MalformedObjectsAreRejectedOnce) {
   }
 }
 
-TEST(Pipeline, DISABLED_ObjectWithTrailingBraceIsOneRejectionNotTwoSteps) {
-  // BUG: {"p":true}} is delivered by the fast path (one step), then the
+TEST(Pipeline, ObjectWithTrailingBraceIsOneRejectionNotTwoSteps) {
+  // Was a bug (fixed): {"p":true}} is delivered by the fast path (one step), then the
   // stream errors on the extra '}', the line is re-read in line mode and
   // delivered again (a second step), and no error is reported. See
-  // JsonlReader.DISABLED_TrailingContentAfterAnObjectIsOneError.
+  // JsonlReader.TrailingContentAfterAnObjectIsOneError.
   const std::string content = "{\"p\":false}\n{\"p\":true}}\n{\"p\":false}\n";
   Result r = run({{"p1", "{p}"}}, discrete_all(), content);
   EXPECT_EQ(r.verdicts, (TVs{{0, false}, {1, false}}));

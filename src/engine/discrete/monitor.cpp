@@ -10,10 +10,18 @@ Step to_step(double v) { return v >= static_cast<double>(kForever) ? kForever : 
 }  // namespace
 
 Monitor::Monitor(const Program& program) {
-  for (const Instr& in : program.code)
-    if (in.code == Code::Atom) atom_count_ = std::max<size_t>(atom_count_, static_cast<size_t>(in.atom) + 1);
-  const size_t zero = atom_count_, one = atom_count_ + 1;
-  size_t slots = atom_count_ + 2;
+  // Local slots for the atoms this property reads (the shared table may hold
+  // many more, from other properties).
+  std::vector<int32_t> local(program.code.size(), -1);
+  for (size_t i = 0; i < program.code.size(); ++i) {
+    const Instr& in = program.code[i];
+    if (in.code != Code::Atom) continue;
+    auto found = std::find(atoms_.begin(), atoms_.end(), static_cast<uint32_t>(in.atom));
+    local[i] = static_cast<int32_t>(found - atoms_.begin());
+    if (found == atoms_.end()) atoms_.push_back(static_cast<uint32_t>(in.atom));
+  }
+  const size_t zero = atoms_.size(), one = atoms_.size() + 1;
+  size_t slots = atoms_.size() + 2;
   if (slots + program.code.size() > 65535) throw std::length_error("property too large (more than 65000 nodes)");
   std::vector<Operand> operand(program.code.size());
   for (size_t i = 0; i < program.code.size(); ++i) {
@@ -21,7 +29,7 @@ Monitor::Monitor(const Program& program) {
     switch (in.code) {
       case Code::True: operand[i] = {static_cast<uint16_t>(one), 0}; continue;
       case Code::False: operand[i] = {static_cast<uint16_t>(zero), 0}; continue;
-      case Code::Atom: operand[i] = {static_cast<uint16_t>(in.atom), 0}; continue;
+      case Code::Atom: operand[i] = {static_cast<uint16_t>(local[i]), 0}; continue;
       case Code::Not: operand[i] = {operand[in.a].slot, static_cast<uint8_t>(!operand[in.a].negate)}; continue;
       default: break;
     }
@@ -54,7 +62,8 @@ Monitor::Monitor(const Program& program) {
 
 bool Monitor::step(const uint8_t* atoms) {
   uint8_t* v = value_.data();
-  std::memcpy(v, atoms, atom_count_);
+  const uint32_t* ids = atoms_.data();
+  for (size_t k = 0, n = atoms_.size(); k < n; ++k) v[k] = atoms[ids[k]];
   const Step now = now_;
   // Locals, not members: stores through uint8_t* may alias anything, which
   // would make the compiler reload every member pointer after each node.

@@ -20,7 +20,7 @@ class Monitor {
   Step now() const { return now_; }  // index of the next step
 
  private:
-  // Operands are slots of one value array: the atoms' values first, then the
+  // Operands are slots of one value array: this property's atoms first, then the
   // constants 0 and 1, then each operator's output. Atoms, constants and
   // negations are not operators at all: `not` is a flag on the operand that
   // reads it. A Timescales property shrinks from 12 nodes to 6 this way.
@@ -38,7 +38,7 @@ class Monitor {
   };
   std::vector<Op> ops_;
   std::vector<uint8_t> value_;
-  size_t atom_count_ = 0;
+  std::vector<uint32_t> atoms_;  // the shared atom table's ids this property reads, in slot order
   Operand root_{};
   std::vector<Pre> pre_;
   std::vector<Once> once_;

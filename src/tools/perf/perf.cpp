@@ -22,6 +22,7 @@
 #endif
 #ifdef RVC_HAVE_DDS
 #include <dds/dds.h>
+#include <unistd.h>
 
 #include "transport/dds/dds_endpoint.hpp"
 #endif
@@ -89,28 +90,6 @@ std::shared_ptr<transport::ZenohSession> open_zenoh(const PerfOptions& o) {
 }
 #endif
 
-#ifdef RVC_HAVE_DDS
-dds_entity_t find_dds_writer(int domain, const std::string& topic) {
-  dds_entity_t pps[16];
-  dds_return_t npp = dds_lookup_participant(static_cast<dds_domainid_t>(domain), pps, 16);
-  for (dds_return_t i = 0; i < npp && i < 16; ++i) {
-    dds_entity_t kids[256];
-    dds_return_t nk = dds_get_children(pps[i], kids, 256);
-    for (dds_return_t j = 0; j < nk && j < 256; ++j) {
-      dds_entity_t ws[256];
-      dds_return_t nw = dds_get_children(kids[j], ws, 256);
-      for (dds_return_t k = 0; k < nw && k < 256; ++k) {
-        dds_entity_t tp = dds_get_topic(ws[k]);
-        if (tp < 0) continue;
-        char name[256];
-        if (dds_get_name(tp, name, sizeof name) >= 0 && topic == name && dds_get_publisher(ws[k]) == kids[j]) return ws[k];
-      }
-    }
-  }
-  return 0;
-}
-#endif
-
 // Opens writers (Sinks) and readers (Sources) of one transport. Zenoh: one
 // session for the process (pub and sub of --inproc share it, so delivery is
 // session-local). DDS: rvc's shared participant, payload type rvc Frame
@@ -131,6 +110,7 @@ class Transport {
       dds_ = o.transports.dds;
       dds_.type = "frame";
       if (o.best_effort) dds_.qos = "best-effort";
+      if (o.write_batch) enable_write_batch();
       return;
 #else
       throw std::invalid_argument("this rvc was built without the dds transport");
@@ -138,24 +118,18 @@ class Transport {
     }
     throw std::invalid_argument("--transport must be zenoh or dds, not '" + o.transport + "'");
   }
+  ~Transport() {
+    if (!temp_config_.empty()) ::unlink(temp_config_.c_str());
+  }
+  Transport(const Transport&) = delete;
+  Transport& operator=(const Transport&) = delete;
 
   std::unique_ptr<transport::Sink> writer(const std::string& name) {
 #ifdef RVC_HAVE_ZENOH
     if (zenoh_) return std::make_unique<transport::ZenohSink>(zenoh_, name, o_.transports.zenoh.express);
 #endif
 #ifdef RVC_HAVE_DDS
-    {
-      auto w = std::make_unique<transport::DdsSink>(name, dds_);
-      if (std::getenv("RVC_PERF_BATCH")) dds_write_set_batch(true);
-      if (std::getenv("RVC_PERF_REG")) {
-        dds_entity_t wr = find_dds_writer(dds_.domain, w->dds_topic());
-        struct { uint64_t seq; const char* data; } sample{0, ""};
-        dds_instance_handle_t ih;
-        int rc = dds_register_instance(wr, &ih, &sample);
-        std::fprintf(stderr, "writer %d register rc %d\n", wr, rc);
-      }
-      return w;
-    }
+    return std::make_unique<transport::DdsSink>(name, dds_);
 #else
     throw std::logic_error("no transport");
 #endif
@@ -182,8 +156,53 @@ class Transport {
 
   std::string uri(const std::string& name) const { return o_.transport + ":" + name; }
 
+  // With --write-batch, samples wait in CycloneDDS's packet until it is full:
+  // push out the last ones (the end-of-stream marker among them). DdsSink
+  // does not expose its writer, so flush every writer of our participant.
+  void flush_batches() {
+#ifdef RVC_HAVE_DDS
+    if (!o_.write_batch) return;
+    dds_entity_t pps[8];
+    const dds_return_t npp = dds_lookup_participant(static_cast<dds_domainid_t>(dds_.domain), pps, 8);
+    for (dds_return_t i = 0; i < std::min<dds_return_t>(npp, 8); ++i) {
+      dds_entity_t groups[64];
+      const dds_return_t ng = dds_get_children(pps[i], groups, 64);
+      for (dds_return_t j = 0; j < std::min<dds_return_t>(ng, 64); ++j) {
+        dds_entity_t writers[64];
+        const dds_return_t nw = dds_get_children(groups[j], writers, 64);
+        for (dds_return_t k = 0; k < std::min<dds_return_t>(nw, 64); ++k)
+          if (dds_get_publisher(writers[k]) == groups[j]) dds_write_flush(writers[k]);
+      }
+    }
+#endif
+  }
+
  private:
+#ifdef RVC_HAVE_DDS
+  // rvc's generated configuration plus <Internal><WriteBatch>, handed to the
+  // DDS transport as a --dds-config file (removed again when done).
+  void enable_write_batch() {
+    if (!dds_.config_file.empty())
+      throw std::invalid_argument(
+          "--write-batch cannot be combined with --dds-config (put <Internal><WriteBatch>true</WriteBatch>"
+          "</Internal> in that file instead)");
+    std::string xml = transport::dds::generated_config_xml(dds_);
+    const auto end = xml.rfind("</Domain>");
+    if (end == std::string::npos) throw std::logic_error("generated DDS configuration has no </Domain>");
+    xml.insert(end, "  <Internal><WriteBatch>true</WriteBatch></Internal>\n  ");
+    char path[] = "/tmp/rvc-perf-XXXXXX.xml";
+    const int fd = ::mkstemps(path, 4);
+    if (fd < 0) throw std::runtime_error("cannot create a temporary DDS configuration file");
+    const bool ok = ::write(fd, xml.data(), xml.size()) == static_cast<ssize_t>(xml.size());
+    ::close(fd);
+    temp_config_ = path;
+    if (!ok) throw std::runtime_error("cannot write " + temp_config_);
+    dds_.config_file = temp_config_;
+  }
+#endif
+
   const PerfOptions& o_;
+  std::string temp_config_;
 #ifdef RVC_HAVE_ZENOH
   std::shared_ptr<transport::ZenohSession> zenoh_;
 #endif
@@ -306,7 +325,7 @@ struct PubResult {
   double seconds = 0;
 };
 
-PubResult publish(const PerfOptions& o, transport::Sink& sink) {
+PubResult publish(const PerfOptions& o, transport::Sink& sink, Transport& t) {
   const std::string payload(o.size, 'x');  // one buffer for the whole run (DDS strings cannot hold NUL)
   const int64_t t0 = now_ns();
   const int64_t deadline = t0 + secs_ns(o.duration);
@@ -338,6 +357,7 @@ PubResult publish(const PerfOptions& o, transport::Sink& sink) {
   }
   const double seconds = (now_ns() - t0) / 1e9;
   sink.put_eos(seq);
+  t.flush_batches();
   sink.flush();
   return {seq, seconds};
 }
@@ -570,7 +590,7 @@ int run_pub(const PerfOptions& o) {
   std::fprintf(stderr, "rvc perf pub: %zu-byte messages at %s for %.1f s on %s%s\n", o.size,
                o.rate > 0 ? (std::to_string(o.rate) + " Hz").c_str() : "max rate", o.duration, t.uri(o.name).c_str(),
                o.inproc ? " (subscriber in this process)" : "");
-  const PubResult r = publish(o, *sink);
+  const PubResult r = publish(o, *sink, t);
   if (o.inproc) {
     if (!s.wait_eos_until(now_ns() + secs_ns(o.timeout)))
       std::fprintf(stderr, "rvc perf pub: in-process subscriber saw no end of stream within %.1f s\n", o.timeout);

@@ -30,6 +30,9 @@ struct PerfOptions {
   std::string name = "rvc_perf";    // key (Zenoh) / topic (DDS); ping/pong use NAME/ping and NAME/pong
   bool best_effort = false;         // Zenoh: congestion control Drop; DDS: best-effort reliability
   bool inproc = false;              // pub/ping: run the subscriber/pong in this process too
+  // DDS pub at max rate: CycloneDDS Internal/WriteBatch (several samples per
+  // packet, as ddsperf does); rvc replay/monitor send each sample at once.
+  bool write_batch = false;
   double timeout = 30;              // hang guard: waiting for a match or the first message
   double idle_timeout = 3;          // sub/pong: stop when nothing arrived for this long
   double warmup = 0;                // ping: round trips sent in the first S seconds are not counted
