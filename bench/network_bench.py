@@ -85,6 +85,7 @@ def main():
     ap.add_argument("--families", default=",".join(FAMILIES))
     ap.add_argument("--bounds", default="10,100,1000")
     ap.add_argument("--skip-latency", action="store_true")
+    ap.add_argument("--batch", type=int, default=1, help="events per published sample (rvc replay --batch)")
     ap.add_argument("--build", default=os.path.join(ROOT, "build", "release"))
     ap.add_argument("--no-docs", action="store_true")
     args = ap.parse_args()
@@ -111,13 +112,14 @@ def main():
             domain += 1
             setup = Setup(rvc, t, domain)
             try:
-                stats, sent = run_pair(setup, spec, path)
+                stats, sent = run_pair(setup, spec, path, extra_rep=["--batch", str(args.batch)])
             finally:
                 setup.close()
             net_s = stats["done_at"] - sent["started_at"]
             row[f"{t}_ms"] = net_s * 1e3
             row[f"{t}_ratio"] = net_s / local_s
-            row[f"{t}_lost"] = stats["gaps"] + stats["duplicates"] + (sent["sent"] - stats["received"])
+            row[f"{t}_lost"] = stats["gaps"] + stats["duplicates"] + (sent.get("samples", sent["sent"]) - stats["received"]) \
+                + (sent["sent"] - stats["checked"])
         rows.append(row)
         print(f"[{n:2d}/{len(files)}] {name:14s} local {local_s*1e3:7.1f} ms  " +
               "  ".join(f"{t} {row[f'{t}_ms']:8.1f} ms ({row[f'{t}_ratio']:.2f}x, lost {row[f'{t}_lost']})"
@@ -145,19 +147,20 @@ def main():
                       f"  p99 {lat.get('p99', 0):9.1f}  ({sent.get('verdicts_back', 0)}/{count} back)", flush=True)
 
     out = os.path.join(ROOT, "bench", "results")
-    with open(os.path.join(out, "network.csv"), "w", newline="") as f:
+    with open(os.path.join(out, f"network-batch{args.batch}.csv"), "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
         w.writeheader()
         w.writerows(rows)
     md = render(rows, latency, transports, args)
-    with open(os.path.join(out, "network.md"), "w") as f:
+    with open(os.path.join(out, f"network-batch{args.batch}.md"), "w") as f:
         f.write(md)
     if not args.no_docs:
         path = os.path.join(ROOT, "docs", "performance.md")
         text = open(path).read()
-        block = "<!-- network:begin -->\n" + md + "<!-- network:end -->"
-        if "<!-- network:begin -->" in text:
-            text = re.sub(r"<!-- network:begin -->.*?<!-- network:end -->", lambda _: block, text, flags=re.S)
+        tag = "network" if args.batch == 1 else f"network-batch{args.batch}"
+        block = f"<!-- {tag}:begin -->\n" + md + f"<!-- {tag}:end -->"
+        if f"<!-- {tag}:begin -->" in text:
+            text = re.sub(rf"<!-- {tag}:begin -->.*?<!-- {tag}:end -->", lambda _: block, text, flags=re.S)
         else:
             text += "\n" + block + "\n"
         open(path, "w").write(text)
@@ -165,8 +168,8 @@ def main():
 
 
 def render(rows, latency, transports, args):
-    out = [f"Machine: {machine()}. {args.steps:,} events per file; network time = first publish to last "
-           f"verdict; local = `rvc check`, best of {args.reps}.\n"]
+    out = [f"Machine: {machine()}. {args.steps:,} events per file, {args.batch} event(s) per published sample; "
+           f"network time = first publish to last verdict; local = `rvc check`, best of {args.reps}.\n"]
     head = "| property | local ms | " + " | ".join(f"{t} ms | {t} / local | {t} lost" for t in transports) + " |"
     out.append(head)
     out.append("|---|---:|" + "---:|---:|---:|" * len(transports))

@@ -42,6 +42,7 @@ PipelineOptions CheckOptions::pipeline_options() const {
   o.time_field = time_field;
   o.max_reported = max_reported;
   o.parse_only = parse_only;
+  o.max_message_size = max_message_size;
   return o;
 }
 

@@ -84,6 +84,11 @@ void add_role(PerfCommand& cmd, CLI::App& perf, const std::string& name, const s
   if (name == "ping")
     s->add_option("--warmup", r.opts.warmup, "Round trips sent in the first S seconds are not counted")
         ->capture_default_str();
+  if (name == "sub" || name == "pub")
+    s->add_option("--warmup", r.opts.warmup,
+                  name == "sub" ? "msgs_per_s leaves out the first S seconds after the first message"
+                                : "With --inproc: msgs_per_s leaves out the first S seconds")
+        ->capture_default_str();
   s->add_option("--timeout", r.opts.timeout, "Seconds to wait for a peer (match or first message)")
       ->capture_default_str();
   s->add_option("--report-interval", r.opts.report_interval, "Progress line period on stderr (0 = none)")

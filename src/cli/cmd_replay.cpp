@@ -30,6 +30,7 @@ struct ReplayCommand {
   double wait_timeout = 10;
   bool no_eos = false;
   bool progress = true;
+  size_t batch = 1;          // messages (lines) per published sample
   std::string latency_from;  // verdict endpoint of a monitor run with --all: measure publish -> verdict
 
   static double wall_now() {
@@ -99,18 +100,36 @@ struct ReplayCommand {
     auto t0 = std::chrono::steady_clock::now();
     const double started_at = wall_now();
     auto next_progress = t0;
+    uint64_t events = 0, samples = 0;
+    std::string pending;  // --batch: lines waiting to go out as one sample
+    size_t pending_lines = 0;
+    auto send = [&](std::string_view payload) {
+      ++samples;
+      if (echo) {
+        std::lock_guard<std::mutex> lock(latency_mutex);
+        sent_at.push_back(std::chrono::steady_clock::now());
+      }
+      sink->put(payload, samples);
+    };
     while (!stop_requested() && (n = ::getline(&line, &cap, in)) >= 0) {
       bytes += n;
       size_t len = static_cast<size_t>(n);
       while (len > 0 && (line[len - 1] == '\n' || line[len - 1] == '\r')) --len;
       if (len == 0) continue;
-      ++seq;
+      ++events;
+      seq = events;
       if (hz > 0) std::this_thread::sleep_until(t0 + std::chrono::duration<double>(static_cast<double>(seq - 1) / hz));
-      if (echo) {
-        std::lock_guard<std::mutex> lock(latency_mutex);
-        sent_at.push_back(std::chrono::steady_clock::now());
+      if (batch <= 1) {
+        send(std::string_view(line, len));
+      } else {
+        pending.append(line, len);
+        pending.push_back('\n');
+        if (++pending_lines == batch) {
+          send(pending);
+          pending.clear();
+          pending_lines = 0;
+        }
       }
-      sink->put(std::string_view(line, len), seq);
       if (show && (seq & 1023) == 0) {
         auto now = std::chrono::steady_clock::now();
         if (now >= next_progress) {
@@ -124,14 +143,17 @@ struct ReplayCommand {
         }
       }
     }
+    if (!pending.empty()) send(pending);
     std::free(line);
     if (in != stdin) std::fclose(in);
-    if (!no_eos) sink->put_eos(seq);
+    seq = samples;  // sequence numbers count samples
+    if (!no_eos) sink->put_eos(samples);
     sink->flush();
     double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (show) std::fprintf(stderr, "\r%60s\r", "");
-    std::fprintf(stderr, "rvc replay: sent %llu messages in %.3f s (%.0f msg/s) to %s\n",
-                 static_cast<unsigned long long>(seq), s, s > 0 ? seq / s : 0.0, to.c_str());
+    std::fprintf(stderr, "rvc replay: sent %llu messages in %llu samples in %.3f s (%.0f msg/s) to %s\n",
+                 static_cast<unsigned long long>(events), static_cast<unsigned long long>(samples), s,
+                 s > 0 ? events / s : 0.0, to.c_str());
     std::string latency;
     if (echo) {
       auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
@@ -149,8 +171,9 @@ struct ReplayCommand {
                     latency_us.size(), pct(0.5), pct(0.9), pct(0.99), latency_us.empty() ? 0.0 : latency_us.back());
       latency = buf;
     }
-    std::printf("{\"sent\":%llu,\"seconds\":%.6f,\"msgs_per_s\":%.1f,\"started_at\":%.6f%s}\n",
-                static_cast<unsigned long long>(seq), s, s > 0 ? seq / s : 0.0, started_at, latency.c_str());
+    std::printf("{\"sent\":%llu,\"samples\":%llu,\"seconds\":%.6f,\"msgs_per_s\":%.1f,\"started_at\":%.6f%s}\n",
+                static_cast<unsigned long long>(events), static_cast<unsigned long long>(samples), s,
+                s > 0 ? events / s : 0.0, started_at, latency.c_str());
     return kOk;
   }
 };
@@ -167,6 +190,10 @@ Runner register_replay(CLI::App& app) {
       ->capture_default_str();
   sub->add_option("--wait-timeout", cmd->wait_timeout, "Seconds to wait for them")->capture_default_str();
   sub->add_flag("--no-eos", cmd->no_eos, "Do not send the end-of-stream marker");
+  sub->add_option("--batch", cmd->batch,
+                  "Messages per published sample (newline-separated; sequence numbers count samples)")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 1 << 20));
   sub->add_flag("!--no-progress", cmd->progress, "No progress line on a terminal");
   sub->add_option("--latency-from", cmd->latency_from,
                   "Verdict endpoint of an `rvc monitor --all`: report publish-to-verdict latency percentiles");

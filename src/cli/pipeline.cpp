@@ -34,7 +34,8 @@ Pipeline::Pipeline(const std::vector<engine::PropertySpec>& properties, const Pi
     : checker_(build(properties, options, std::move(on_verdict))),
       options_(options),
       decoder_(checker_.atoms(), io::DecoderOptions{options.model == engine::TimeModel::Dense, options.time_field,
-                                                    options.strict}) {}
+                                                    options.strict}),
+      batch_reader_(*this, options.max_message_size) {}
 
 void Pipeline::report(const std::string& text) {
   if (reported_++ < options_.max_reported) std::fprintf(stderr, "rvc: %s\n", text.c_str());
@@ -42,7 +43,9 @@ void Pipeline::report(const std::string& text) {
 
 void Pipeline::on_error(const io::LineError& error) {
   ++stats_.rejected;
-  std::string where = options_.position_name + " " + std::to_string(error.line);
+  std::string where = batch_position_ ? options_.position_name + " " + std::to_string(batch_position_) + ", line " +
+                                            std::to_string(error.line)
+                                      : options_.position_name + " " + std::to_string(error.line);
   if (error.column) where += ", column " + std::to_string(error.column);
   report(where + ": " + error.message + " (message skipped)");
 }
@@ -95,6 +98,12 @@ void Pipeline::commit() {
 }
 
 void Pipeline::feed(std::string_view payload, uint64_t position) {
+  if (payload.find('\n') != std::string_view::npos) {
+    batch_position_ = position;
+    batch_reader_.read(payload, 1);
+    batch_position_ = 0;
+    return;
+  }
   io::parse_one(parser_, payload, position, *this, scratch_);
 }
 

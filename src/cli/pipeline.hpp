@@ -23,6 +23,7 @@ struct PipelineOptions {
   std::string position_name = "line";  // how errors name a message: "line 12", "seq 12"
   size_t max_reported = 100;           // errors and warnings printed before going quiet
   bool parse_only = false;             // decode every message but run no monitor (benchmark floor)
+  size_t max_message_size = 1 << 20;   // longest line inside a batched payload
 };
 
 struct PipelineStats {
@@ -43,6 +44,7 @@ class Pipeline final : public io::JsonlHandler {
   void discard() override { pending_ = false; }
   void on_error(const io::LineError& error) override;
   // One network payload; `position` names it in errors (its sequence number).
+  // A payload holding several lines is a batch: one message per line.
   void feed(std::string_view payload, uint64_t position);
 
   const PipelineStats& stats() const { return stats_; }
@@ -66,6 +68,8 @@ class Pipeline final : public io::JsonlHandler {
   std::string json_error_;
   simdjson::ondemand::parser parser_;
   std::string scratch_;
+  io::ChunkReader batch_reader_;
+  uint64_t batch_position_ = 0;  // position of the payload being read as a batch, else 0
 };
 
 }  // namespace rvc::cli

@@ -162,6 +162,21 @@ class ChunkProcessor {
 
 }  // namespace
 
+struct ChunkReader::Impl {
+  Impl(JsonlHandler& handler, size_t max_line) : processor(handler, max_line) {}
+  ChunkProcessor processor;
+  std::string buf;
+};
+
+ChunkReader::ChunkReader(JsonlHandler& handler, size_t max_line) : impl_(std::make_unique<Impl>(handler, max_line)) {}
+ChunkReader::~ChunkReader() = default;
+
+void ChunkReader::read(std::string_view text, uint64_t first_line) {
+  impl_->buf.assign(text.data(), text.size());
+  impl_->buf.append(simdjson::SIMDJSON_PADDING, ' ');
+  impl_->processor.process(impl_->buf.data(), text.size(), first_line);
+}
+
 uint64_t Position::number() const {
   if (!base_) return number_;
   const char* at = base_ + offset_;

@@ -14,6 +14,7 @@
 #include <simdjson.h>
 
 #include <cstdint>
+#include <memory>
 #include <string>
 
 namespace rvc::io {
@@ -73,6 +74,19 @@ struct ReaderOptions {
 
 // Reads fd to its end. Returns false (with `error`) only on I/O failure.
 bool read_jsonl(int fd, JsonlHandler& handler, const ReaderOptions& options, std::string& error);
+
+// Reads JSON lines held in memory (a network payload that batches several
+// messages, one per line) through the same fast path as files.
+class ChunkReader {
+ public:
+  ChunkReader(JsonlHandler& handler, size_t max_line);
+  ~ChunkReader();
+  void read(std::string_view text, uint64_t first_line);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 // Parses one message (one line or one network payload) and hands it over.
 // `scratch` keeps a padded copy when the payload lacks simdjson's padding.

@@ -218,6 +218,10 @@ class Transport {
 // atomics let the main thread print progress without locking per message.
 struct SubCounter {
   transport::SeqCounters c;  // transport thread only
+  int64_t warmup_ns = 0;     // msgs_per_s counts from first message + warmup
+  bool warm = false;         // transport thread only
+  std::atomic<int64_t> warm_ns{0};
+  std::atomic<uint64_t> warm_received{0}, warm_bytes{0};
   std::atomic<uint64_t> received{0}, gaps{0}, bytes{0};
   std::atomic<int64_t> first_ns{0}, last_ns{0};
   std::mutex mu;
@@ -239,6 +243,12 @@ struct SubCounter {
     }
     const int64_t t = now_ns();
     if (c.received == 0) first_ns.store(t, std::memory_order_relaxed);
+    if (!warm && t - first_ns.load(std::memory_order_relaxed) >= warmup_ns) {
+      warm = true;  // the steady-state window starts with this message
+      warm_ns.store(t, std::memory_order_relaxed);
+      warm_received.store(c.received, std::memory_order_relaxed);
+      warm_bytes.store(bytes.load(std::memory_order_relaxed), std::memory_order_relaxed);
+    }
     last_ns.store(t, std::memory_order_relaxed);
     c.on_seq(f.seq);
     bytes.store(bytes.load(std::memory_order_relaxed) + f.payload.size(), std::memory_order_relaxed);
@@ -295,26 +305,31 @@ bool follow_subscription(const PerfOptions& o, SubCounter& s, const char* who) {
   }
 }
 
-// The subscriber's summary. msgs_per_s counts from the first to the last
-// message received, so discovery and the wait for the end of stream do not
-// dilute it.
+// The subscriber's summary. msgs_per_s counts from the first message (plus
+// --warmup seconds) to the last one, so discovery, the ramp-up and the wait
+// for the end of stream do not dilute it; avg_msgs_per_s is first to last.
 std::string sub_json(const PerfOptions& o, const char* role, SubCounter& s, uint64_t sent_by_pub) {
   const uint64_t received = s.c.received;
   const bool eos = s.has_eos();
   const uint64_t sent = sent_by_pub ? sent_by_pub : eos ? s.eos_seq : s.c.last_seq;
   const double span = (s.last_ns.load() - s.first_ns.load()) / 1e9;
-  const double mps = received > 1 && span > 0 ? (received - 1) / span : 0;
+  const double avg = received > 1 && span > 0 ? (received - 1) / span : 0;
+  const double steady_span = (s.last_ns.load() - s.warm_ns.load()) / 1e9;
+  const uint64_t steady_n = received - s.warm_received.load();
+  // Too little after the warm-up (a short run): fall back to the whole run.
+  const bool steady = s.warm && steady_n > 100 && steady_span > 0.2;
+  const double mps = steady ? steady_n / steady_span : avg;
   const double avg_size = received ? static_cast<double>(s.bytes.load()) / received : static_cast<double>(o.size);
   const double mbps = mps * avg_size * 8 / 1e6;
-  char buf[512];
+  char buf[640];
   std::snprintf(buf, sizeof buf,
                 "{\"role\":\"%s\",\"transport\":\"%s\",\"size\":%.0f,\"msgs_per_s\":%.1f,\"mbps\":%.3f,"
                 "\"lost\":%llu,\"sent\":%llu,\"received\":%llu,\"duplicates\":%llu,\"seconds\":%.6f,"
-                "\"reliable\":%s,\"eos\":%s}",
+                "\"avg_msgs_per_s\":%.1f,\"steady_seconds\":%.6f,\"reliable\":%s,\"eos\":%s}",
                 role, o.transport.c_str(), avg_size, mps, mbps, static_cast<unsigned long long>(s.c.gaps),
                 static_cast<unsigned long long>(sent), static_cast<unsigned long long>(received),
-                static_cast<unsigned long long>(s.c.duplicates), span, o.best_effort ? "false" : "true",
-                eos ? "true" : "false");
+                static_cast<unsigned long long>(s.c.duplicates), span, avg, steady ? steady_span : span,
+                o.best_effort ? "false" : "true", eos ? "true" : "false");
   return buf;
 }
 
@@ -567,6 +582,7 @@ int run_sub(const PerfOptions& o) {
   Transport t(o);
   auto src = t.reader(o.name);
   SubCounter s;
+  s.warmup_ns = secs_ns(o.warmup);
   src->start([&s](const Frame& f) { s.on_frame(f); });
   std::fprintf(stderr, "rvc perf sub: ready on %s\n", t.uri(o.name).c_str());
   const bool got = follow_subscription(o, s, "sub");
@@ -580,6 +596,7 @@ int run_sub(const PerfOptions& o) {
 int run_pub(const PerfOptions& o) {
   Transport t(o);
   SubCounter s;
+  s.warmup_ns = secs_ns(o.warmup);
   std::unique_ptr<transport::Source> local;
   if (o.inproc) {
     local = t.reader(o.name);
@@ -615,7 +632,12 @@ int run_pong(const PerfOptions& o) {
   SubCounter s;  // counts pings; its end of stream ends the pong
   transport::Sink* out = sink.get();
   src->start([&s, out](const Frame& f) {
-    if (!f.eos) out->put(f.payload, f.seq);
+    // The end of the pings ends the pongs too (so a bridge in between can
+    // see both directions end).
+    if (f.eos)
+      out->put_eos(f.seq);
+    else
+      out->put(f.payload, f.seq);
     s.on_frame(f);
   });
   std::fprintf(stderr, "rvc perf pong: ready on %s, answering on %s\n", t.uri(o.name + "/ping").c_str(),

@@ -35,7 +35,9 @@ struct PerfOptions {
   bool write_batch = false;
   double timeout = 30;              // hang guard: waiting for a match or the first message
   double idle_timeout = 3;          // sub/pong: stop when nothing arrived for this long
-  double warmup = 0;                // ping: round trips sent in the first S seconds are not counted
+  // ping: round trips sent in the first S seconds are not counted; sub (and
+  // pub --inproc): msgs_per_s starts S seconds after the first message
+  double warmup = 0;
   double report_interval = 1;       // progress line period on stderr (0 = none)
   transport::TransportOptions transports;
   std::function<bool()> should_stop;  // polled: true ends the run early (signals)
