@@ -171,7 +171,8 @@ class Deployment:
 
     # -- plan ---------------------------------------------------------------------------------
     def services(self):
-        return {"a": ["monitor", "publisher"], "b": ["monitor", "sync", "app"],
+        holder = ["netns"] if self.mode == "shared" else []  # owner of the shared namespace
+        return holder + {"a": ["monitor", "publisher"], "b": ["monitor", "sync", "app"],
                 "c": ["router", "monitor", "bridge", "publisher"],
                 "d": ["router", "monitor", "bridge", "sync", "app"]}[self.arch]
 

@@ -75,6 +75,10 @@ def with_heartbeats(events, step=0.25):
     verdicts do not depend on heartbeats (test_dense_heartbeats_change_nothing).
     """
     out = []
+    t = 0.0  # the timeline starts at 0, before the first message too
+    while t < events[0]["time"] - 1e-9:
+        out.append({"time": t})
+        t += step
     for e, nxt in zip(events, events[1:] + [None]):
         out.append(e)
         if nxt is None:
