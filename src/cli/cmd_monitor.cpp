@@ -119,8 +119,10 @@ struct MonitorCommand {
     }
     counters.rejected = pipeline.stats().rejected;
     std::string final_stats = stats_json(counters, pipeline, verdicts, eos);  // done_at: last verdict out
-    source->stop();
+    // Close the queue before stopping the source: stop() waits for a running
+    // transport callback, which may be blocked on a full queue.
     queue.close();
+    source->stop();
     pipeline.finish_report();
     std::fprintf(stderr, "%s\n", final_stats.c_str());
     if (stats_sink) {
