@@ -198,6 +198,8 @@ class Transport {
     temp_config_ = path;
     if (!ok) throw std::runtime_error("cannot write " + temp_config_);
     dds_.config_file = temp_config_;
+    dds_.peers.clear();  // already in the XML (and not allowed next to a config file)
+    dds_.trace_file.clear();
   }
 #endif
 
