@@ -81,7 +81,13 @@ struct BridgeCommand {
       }
     }
     for (auto& r : routes) {
-      r->source = transport::open_source(r->from, transports);
+      // dds: -> anything but dds: forwards on CycloneDDS's receive thread; a
+      // dds: sink may wait for acknowledgements that only that thread receives.
+      transport::TransportOptions from_opts = transports;
+#ifdef RVC_HAVE_DDS
+      from_opts.dds.deliver_on_receive_thread = transport::scheme_of(r->to) != "dds";
+#endif
+      r->source = transport::open_source(r->from, from_opts);
       Route* route = r.get();
       r->source->start([route](const transport::Frame& f) {
         if (f.eos) {

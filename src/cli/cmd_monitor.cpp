@@ -73,6 +73,14 @@ struct MonitorCommand {
     });
 
     transport::FrameQueue queue(queue_capacity);
+    // A dds: input may hand samples over on CycloneDDS's receive thread unless
+    // a dds: output could block the engine (and so a full queue, and so that
+    // thread) while it waits for acknowledgements only that thread receives.
+#ifdef RVC_HAVE_DDS
+    bool dds_out = !stats_output.empty() && transport::scheme_of(stats_output) == "dds";
+    for (const auto& uri : outputs) dds_out = dds_out || transport::scheme_of(uri) == "dds";
+    transports.dds.deliver_on_receive_thread = !dds_out;
+#endif
     auto source = transport::open_source(input, transports);
     install_stop_signals();
     source->start([&](const transport::Frame& f) { queue.push(f); });
@@ -89,10 +97,20 @@ struct MonitorCommand {
       std::fprintf(stderr, "%s\n", js.c_str());
       if (stats_sink) stats_sink->put(js, 0);
     };
+    // Sinks get idle() when the input pauses, so buffered verdicts (file
+    // buffers, DDS write batches) go out within about a millisecond of the
+    // last input, but not after every small batch of a busy stream.
+    auto last_idle = std::chrono::steady_clock::now();
+    bool idle_due = false;
+    auto idle_sinks = [&] {
+      for (auto& s : sinks) s->idle();
+      last_idle = std::chrono::steady_clock::now();
+      idle_due = false;
+    };
     while (!stop_requested() && !(eos && exit_on_eos)) {
-      if (!queue.pop_batch(batch, count, 100)) break;
+      if (!queue.pop_batch(batch, count, idle_due ? 1 : 100)) break;
       if (count == 0) {
-        for (auto& s : sinks) s->idle();
+        idle_sinks();
         continue;
       }
       if (count > 0 && first_at == 0) first_at = wall_now();
@@ -105,6 +123,12 @@ struct MonitorCommand {
         }
         counters.on_seq(f.seq);
         pipeline.feed(f.payload, f.seq ? f.seq : counters.received);
+      }
+      if (queue.empty()) {
+        if (std::chrono::steady_clock::now() - last_idle >= std::chrono::milliseconds(1))
+          idle_sinks();
+        else
+          idle_due = true;
       }
       if (stats_requested()) publish_stats();
       if (stats_interval > 0 &&

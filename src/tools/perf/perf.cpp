@@ -110,16 +110,13 @@ class Transport {
       dds_ = o.transports.dds;
       dds_.type = "frame";
       if (o.best_effort) dds_.qos = "best-effort";
-      if (o.write_batch) enable_write_batch();
+      dds_.write_batch = o.write_batch;
       return;
 #else
       throw std::invalid_argument("this rvc was built without the dds transport");
 #endif
     }
     throw std::invalid_argument("--transport must be zenoh or dds, not '" + o.transport + "'");
-  }
-  ~Transport() {
-    if (!temp_config_.empty()) ::unlink(temp_config_.c_str());
   }
   Transport(const Transport&) = delete;
   Transport& operator=(const Transport&) = delete;
@@ -135,12 +132,18 @@ class Transport {
 #endif
   }
 
-  std::unique_ptr<transport::Source> reader(const std::string& name) {
+  // counting_only: the handler only counts (sub, in-process sub), so a DDS
+  // reader may run it on CycloneDDS's receive thread. Pong and ping handlers
+  // write samples, which may wait for acknowledgements that only that thread
+  // can process: they keep the reader's own thread.
+  std::unique_ptr<transport::Source> reader(const std::string& name, bool counting_only = false) {
 #ifdef RVC_HAVE_ZENOH
     if (zenoh_) return std::make_unique<transport::ZenohSource>(zenoh_, name);
 #endif
 #ifdef RVC_HAVE_DDS
-    return std::make_unique<transport::DdsSource>(name, dds_);
+    transport::DdsOptions d = dds_;
+    d.deliver_on_receive_thread = counting_only;
+    return std::make_unique<transport::DdsSource>(name, d);
 #else
     throw std::logic_error("no transport");
 #endif
@@ -156,55 +159,8 @@ class Transport {
 
   std::string uri(const std::string& name) const { return o_.transport + ":" + name; }
 
-  // With --write-batch, samples wait in CycloneDDS's packet until it is full:
-  // push out the last ones (the end-of-stream marker among them). DdsSink
-  // does not expose its writer, so flush every writer of our participant.
-  void flush_batches() {
-#ifdef RVC_HAVE_DDS
-    if (!o_.write_batch) return;
-    dds_entity_t pps[8];
-    const dds_return_t npp = dds_lookup_participant(static_cast<dds_domainid_t>(dds_.domain), pps, 8);
-    for (dds_return_t i = 0; i < std::min<dds_return_t>(npp, 8); ++i) {
-      dds_entity_t groups[64];
-      const dds_return_t ng = dds_get_children(pps[i], groups, 64);
-      for (dds_return_t j = 0; j < std::min<dds_return_t>(ng, 64); ++j) {
-        dds_entity_t writers[64];
-        const dds_return_t nw = dds_get_children(groups[j], writers, 64);
-        for (dds_return_t k = 0; k < std::min<dds_return_t>(nw, 64); ++k)
-          if (dds_get_publisher(writers[k]) == groups[j]) dds_write_flush(writers[k]);
-      }
-    }
-#endif
-  }
-
  private:
-#ifdef RVC_HAVE_DDS
-  // rvc's generated configuration plus <Internal><WriteBatch>, handed to the
-  // DDS transport as a --dds-config file (removed again when done).
-  void enable_write_batch() {
-    if (!dds_.config_file.empty())
-      throw std::invalid_argument(
-          "--write-batch cannot be combined with --dds-config (put <Internal><WriteBatch>true</WriteBatch>"
-          "</Internal> in that file instead)");
-    std::string xml = transport::dds::generated_config_xml(dds_);
-    const auto end = xml.rfind("</Domain>");
-    if (end == std::string::npos) throw std::logic_error("generated DDS configuration has no </Domain>");
-    xml.insert(end, "  <Internal><WriteBatch>true</WriteBatch></Internal>\n  ");
-    char path[] = "/tmp/rvc-perf-XXXXXX.xml";
-    const int fd = ::mkstemps(path, 4);
-    if (fd < 0) throw std::runtime_error("cannot create a temporary DDS configuration file");
-    const bool ok = ::write(fd, xml.data(), xml.size()) == static_cast<ssize_t>(xml.size());
-    ::close(fd);
-    temp_config_ = path;
-    if (!ok) throw std::runtime_error("cannot write " + temp_config_);
-    dds_.config_file = temp_config_;
-    dds_.peers.clear();  // already in the XML (and not allowed next to a config file)
-    dds_.trace_file.clear();
-  }
-#endif
-
   const PerfOptions& o_;
-  std::string temp_config_;
 #ifdef RVC_HAVE_ZENOH
   std::shared_ptr<transport::ZenohSession> zenoh_;
 #endif
@@ -374,7 +330,6 @@ PubResult publish(const PerfOptions& o, transport::Sink& sink, Transport& t) {
   }
   const double seconds = (now_ns() - t0) / 1e9;
   sink.put_eos(seq);
-  t.flush_batches();
   sink.flush();
   return {seq, seconds};
 }
@@ -582,7 +537,7 @@ LatencyStats latency_stats(std::vector<uint32_t>& rtt_ns) {
 
 int run_sub(const PerfOptions& o) {
   Transport t(o);
-  auto src = t.reader(o.name);
+  auto src = t.reader(o.name, /*counting_only=*/true);
   SubCounter s;
   s.warmup_ns = secs_ns(o.warmup);
   src->start([&s](const Frame& f) { s.on_frame(f); });
@@ -601,7 +556,7 @@ int run_pub(const PerfOptions& o) {
   s.warmup_ns = secs_ns(o.warmup);
   std::unique_ptr<transport::Source> local;
   if (o.inproc) {
-    local = t.reader(o.name);
+    local = t.reader(o.name, /*counting_only=*/true);
     local->start([&s](const Frame& f) { s.on_frame(f); });
   }
   auto sink = t.writer(o.name);

@@ -181,17 +181,24 @@ bool wait_status(dds_entity_t participant, dds_entity_t entity, uint32_t mask, G
 
 struct DdsSource::Impl {
   Endpoint ep;
+  const bool on_receive_thread;
   dds_entity_t reader = 0, readcond = 0, guard = 0, waitset = 0;
   FrameHandler handler;
   std::thread thread;
-  std::atomic<bool> stop_requested{false};
+  std::atomic<bool> started{false}, stop_requested{false};
+  // Listener mode: CycloneDDS may call the listener from several threads (its
+  // receive thread, and a local writer's thread for in-process delivery);
+  // one drain at a time keeps each writer's samples in order.
+  std::mutex drain_mu;
+  std::atomic<std::thread::id> draining{};
   std::unordered_map<dds_instance_handle_t, uint64_t> arrivals;  // per writer (String type)
 
-  Impl(const std::string& topic, const DdsOptions& o) : ep(topic, o, false) {
+  Impl(const std::string& topic, const DdsOptions& o) : ep(topic, o, false), on_receive_thread(o.deliver_on_receive_thread) {
     dds_qos_t* rq = make_qos(ep.qos, o.partition, false);
     reader = dds_create_reader(ep.group, ep.topic, rq, nullptr);
     dds_delete_qos(rq);
     if (reader < 0) fail("cannot create reader on '" + ep.name + "'", reader);
+    if (on_receive_thread) return;
     readcond = dds_create_readcondition(reader, DDS_ANY_STATE);
     guard = dds_create_guardcondition(ep.dom->participant);
     waitset = dds_create_waitset(ep.dom->participant);
@@ -204,9 +211,9 @@ struct DdsSource::Impl {
     dds_waitset_attach(waitset, guard, guard);
   }
   ~Impl() {
-    dds_delete(waitset);
-    dds_delete(guard);
-    dds_delete(reader);  // also deletes readcond
+    if (waitset > 0) dds_delete(waitset);
+    if (guard > 0) dds_delete(guard);
+    dds_delete(reader);  // also deletes readcond and the listener
   }
 
   void deliver(const void* sample, const dds_sample_info_t& info) {
@@ -233,34 +240,54 @@ struct DdsSource::Impl {
     handler(f);
   }
 
-  void run() {
+  // Takes what the reader holds, in batches of loaned samples, and hands each
+  // to the handler. False once delivery must stop (stop() or a failing handler).
+  bool take_all(dds_entity_t from) {
     constexpr int32_t kBatch = 256;
-    std::vector<void*> samples(kBatch);
-    std::vector<dds_sample_info_t> infos(kBatch);
+    void* samples[kBatch];
+    dds_sample_info_t infos[kBatch];
+    for (;;) {
+      if (stop_requested.load()) return false;
+      samples[0] = nullptr;  // loan the sample buffers from the reader
+      dds_return_t n = dds_take(from, samples, infos, kBatch, kBatch);
+      if (n <= 0) return true;
+      bool ok = true;
+      for (dds_return_t i = 0; i < n && ok && !stop_requested.load(); ++i) {
+        if (!infos[i].valid_data) continue;  // unregister/dispose notifications
+        try {
+          deliver(samples[i], infos[i]);
+        } catch (const std::exception& e) {
+          std::fprintf(stderr, "rvc: dds: frame handler failed on '%s': %s; delivery stopped\n", ep.name.c_str(), e.what());
+          ok = false;
+        } catch (...) {
+          std::fprintf(stderr, "rvc: dds: frame handler failed on '%s'; delivery stopped\n", ep.name.c_str());
+          ok = false;
+        }
+      }
+      dds_return_loan(from, samples, n);
+      if (!ok) {
+        stop_requested = true;
+        return false;
+      }
+      if (n < kBatch) return true;
+    }
+  }
+
+  // Listener mode: runs on whichever thread CycloneDDS signals data on.
+  void drain() {
+    std::lock_guard lock(drain_mu);
+    draining = std::this_thread::get_id();
+    take_all(reader);
+    draining = std::thread::id{};
+  }
+
+  static void on_data_available(dds_entity_t, void* arg) { static_cast<Impl*>(arg)->drain(); }
+
+  // Thread mode: the source's own thread sleeps on a waitset.
+  void run() {
     while (!stop_requested.load()) {
       dds_waitset_wait(waitset, nullptr, 0, DDS_INFINITY);
-      for (;;) {
-        if (stop_requested.load()) return;
-        samples[0] = nullptr;  // loan the sample buffers from the reader
-        dds_return_t n = dds_take(readcond, samples.data(), infos.data(), kBatch, kBatch);
-        if (n <= 0) break;
-        bool ok = true;
-        for (dds_return_t i = 0; i < n && ok; ++i) {
-          if (!infos[i].valid_data) continue;  // unregister/dispose notifications
-          try {
-            deliver(samples[i], infos[i]);
-          } catch (const std::exception& e) {
-            std::fprintf(stderr, "rvc: dds: frame handler failed on '%s': %s; delivery stopped\n", ep.name.c_str(), e.what());
-            ok = false;
-          } catch (...) {
-            std::fprintf(stderr, "rvc: dds: frame handler failed on '%s'; delivery stopped\n", ep.name.c_str());
-            ok = false;
-          }
-        }
-        dds_return_loan(readcond, samples.data(), n);
-        if (!ok) { stop_requested = true; return; }
-        if (n < kBatch) break;
-      }
+      if (!take_all(readcond)) return;
     }
   }
 };
@@ -270,20 +297,40 @@ DdsSource::DdsSource(std::string topic, DdsOptions opts) : impl_(std::make_uniqu
 DdsSource::~DdsSource() { stop(); }
 
 void DdsSource::start(FrameHandler handler) {
-  if (impl_->thread.joinable() || impl_->stop_requested) throw std::logic_error("dds: source already started");
+  if (impl_->started.exchange(true)) throw std::logic_error("dds: source already started");
   impl_->handler = std::move(handler);
-  impl_->thread = std::thread([this] { impl_->run(); });
+  if (!impl_->on_receive_thread) {
+    impl_->thread = std::thread([this] { impl_->run(); });
+    return;
+  }
+  dds_listener_t* l = dds_create_listener(impl_.get());
+  dds_lset_data_available(l, &Impl::on_data_available);
+  dds_return_t rc = dds_set_listener(impl_->reader, l);
+  dds_delete_listener(l);
+  if (rc < 0) fail("cannot set the data listener on '" + impl_->ep.name + "'", rc);
+  // Samples that arrived before the listener was set raised no callback.
+  impl_->drain();
 }
 
 void DdsSource::stop() {
   if (!impl_) return;
-  impl_->stop_requested = true;
-  dds_set_guardcondition(impl_->guard, true);
-  if (impl_->thread.joinable()) {
-    if (impl_->thread.get_id() == std::this_thread::get_id())
-      impl_->thread.detach();  // called from the handler: the loop exits after it returns
+  Impl& m = *impl_;
+  m.stop_requested = true;
+  if (m.on_receive_thread) {
+    // Called from the handler: the drain stops after it returns.
+    if (m.draining.load() == std::this_thread::get_id()) return;
+    if (m.started) {
+      dds_set_listener(m.reader, nullptr);  // waits for a listener call in progress
+      std::lock_guard lock(m.drain_mu);     // and for start()'s own drain
+    }
+    return;
+  }
+  dds_set_guardcondition(m.guard, true);
+  if (m.thread.joinable()) {
+    if (m.thread.get_id() == std::this_thread::get_id())
+      m.thread.detach();  // called from the handler: the loop exits after it returns
     else
-      impl_->thread.join();
+      m.thread.join();
   }
 }
 
@@ -352,6 +399,12 @@ void DdsSink::put(std::string_view payload, uint64_t seq) {
 void DdsSink::put_eos(uint64_t last_seq) {
   std::lock_guard lock(impl_->mu);
   impl_->write(dds::format_eos(EosMarker{last_seq, impl_->written}), last_seq);
+  dds_write_flush(impl_->writer);  // with write batching the marker would wait for a full packet
+}
+
+void DdsSink::idle() {
+  std::lock_guard lock(impl_->mu);
+  dds_write_flush(impl_->writer);
 }
 
 bool DdsSink::wait_matched(size_t n, std::chrono::milliseconds timeout) {
@@ -361,6 +414,10 @@ bool DdsSink::wait_matched(size_t n, std::chrono::milliseconds timeout) {
 }
 
 void DdsSink::flush() {
+  {
+    std::lock_guard lock(impl_->mu);
+    dds_write_flush(impl_->writer);
+  }
   dds_return_t rc = dds_wait_for_acks(impl_->writer, to_dds(impl_->ep.qos.max_blocking));
   if (rc == DDS_RETCODE_TIMEOUT)
     throw std::runtime_error("dds: readers of '" + impl_->ep.name + "' did not acknowledge within max-blocking=" +

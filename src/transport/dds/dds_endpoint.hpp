@@ -20,7 +20,9 @@ namespace rvc::transport {
 
 // Subscribes on construction (samples arriving before start() are kept by the
 // keep-all reader and delivered once started). start() runs a waitset thread
-// that takes samples in batches and calls the handler for each:
+// that takes samples in batches and calls the handler for each, or, with
+// DdsOptions::deliver_on_receive_thread, sets a data-available listener that
+// does the same on CycloneDDS's own thread (one thread hand-off less):
 //   data    -> Frame{payload, seq}   seq: the Frame type's seq field, or with
 //              std_msgs/String the 1-based arrival index per writer (DDS
 //              delivers a reliable writer's samples once and in order)
@@ -62,6 +64,8 @@ class DdsSink final : public Sink {
   bool wait_matched(size_t n, std::chrono::milliseconds timeout) override;
   // Waits until every matched reliable reader acknowledged all samples.
   void flush() override;
+  // Sends what write batching holds back (DdsOptions::write_batch).
+  void idle() override;
 
   const std::string& dds_topic() const;
   uint64_t written() const;  // data samples written (not counting the marker)

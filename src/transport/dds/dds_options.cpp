@@ -147,6 +147,10 @@ void validate(const DdsOptions& o) {
     throw std::invalid_argument("--dds-trace cannot be combined with --dds-config: add a <Tracing> section to your file");
   if (!o.config_file.empty() && !o.peers.empty())
     throw std::invalid_argument("--dds-peer cannot be combined with --dds-config: add <Discovery><Peers> to your file");
+  if (!o.config_file.empty() && o.write_batch)
+    throw std::invalid_argument(
+        "--dds-write-batch cannot be combined with --dds-config: add <Internal><WriteBatch>true</WriteBatch></Internal> "
+        "to your file");
   for (const auto& p : o.peers)
     if (p.empty()) throw std::invalid_argument("--dds-peer: empty address");
 }
@@ -217,6 +221,7 @@ std::string generated_config_xml(const DdsOptions& o) {
     x += "      </Peers>\n";
   }
   x += "    </Discovery>\n";
+  if (o.write_batch) x += "    <Internal><WriteBatch>true</WriteBatch></Internal>\n";
   if (!o.trace_file.empty()) {
     x += "    <Tracing>\n";
     x += "      <Category>config,info,discovery</Category>\n";
@@ -296,6 +301,9 @@ void add_dds_options(CLI::App& app, DdsOptions& o) {
       ->check(CLI::ExistingFile)
       ->group(group);
   app.add_option("--dds-trace", o.trace_file, "Write a CycloneDDS trace (config, discovery) to this file")
+      ->group(group);
+  app.add_flag("--dds-write-batch", o.write_batch,
+               "Pack several samples per packet (CycloneDDS WriteBatch; flushed when idle and at the end)")
       ->group(group);
   app.add_flag_callback(
          "--no-ros2-names", [&o] { o.ros2 = false; },

@@ -1,7 +1,7 @@
 // In-process tests of the dds: transport over loopback: option parsing, topic
 // naming, the end-of-stream marker, the generated configuration, pub->sub
 // payload/sequence accounting, and that the participant's sockets stay on
-// loopback. Each test uses its own domain id (40..49) and a per-process topic
+// loopback. Each test uses its own domain id (40..51) and a per-process topic
 // so that parallel runs do not interfere. Timeouts below are hang guards only.
 #include <gtest/gtest.h>
 
@@ -11,6 +11,7 @@
 #include <netinet/in.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <condition_variable>
 #include <cstring>
 #include <filesystem>
@@ -19,6 +20,7 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "transport/dds/dds_endpoint.hpp"
@@ -325,6 +327,84 @@ TEST(DdsPubSub, StringTypeLossShowsUpAsGapsAtEos) {
   EXPECT_EQ(c.eos_seq, 10u);                          // the writer's count
   EXPECT_EQ(c.counters.received, 2u);
   EXPECT_EQ(c.counters.gaps, 8u);
+}
+
+// Delivery on CycloneDDS's thread (a data-available listener): samples written
+// before start() and after it arrive once, in order, each writer's seq intact;
+// nothing is delivered after stop() returns.
+TEST(DdsPubSub, ReceiveThreadDeliveryKeepsOrderAndStopsAtStop) {
+  const auto topic = unique_topic("listener");
+  DdsOptions o = opts_for(50);
+  o.type = "frame";
+  o.deliver_on_receive_thread = true;
+  DdsSource src(topic, o);
+  DdsSink sink(topic, o);
+  ASSERT_TRUE(sink.wait_matched(1, kHang));
+  for (uint64_t s = 1; s <= 500; ++s) sink.put("{\"s\":" + std::to_string(s) + "}", s);  // before start
+  Collector c;
+  std::atomic<bool> stopped{false};
+  std::atomic<int> after_stop{0};
+  FrameHandler collect = c.handler();
+  src.start([&](const Frame& f) {
+    if (stopped.load()) after_stop.fetch_add(1);
+    collect(f);
+  });
+  {
+    std::unique_lock lock(c.mu);  // no new sample raises a callback: start() itself must deliver these
+    ASSERT_TRUE(c.cv.wait_for(lock, kHang, [&] { return c.payloads.size() == 500; }));
+  }
+  std::thread second([&] {  // a second writer thread on the same topic
+    DdsSink other(topic, o);
+    for (uint64_t s = 1; s <= 300; ++s) other.put("{\"o\":" + std::to_string(s) + "}", 100000 + s);
+    other.flush();
+  });
+  for (uint64_t s = 501; s <= 3000; ++s) sink.put("{\"s\":" + std::to_string(s) + "}", s);
+  second.join();
+  sink.put_eos(3000);
+  ASSERT_TRUE(c.wait_eos());
+  src.stop();
+  stopped = true;
+  for (uint64_t s = 3001; s <= 3100; ++s) sink.put("{\"s\":" + std::to_string(s) + "}", s);
+  sink.flush();
+  std::this_thread::sleep_for(100ms);
+  EXPECT_EQ(after_stop.load(), 0);
+  std::lock_guard lock(c.mu);
+  std::vector<uint64_t> mine, other;
+  for (uint64_t s : c.seqs) (s > 100000 ? other : mine).push_back(s);
+  ASSERT_EQ(mine.size(), 3000u);
+  ASSERT_EQ(other.size(), 300u);
+  for (size_t i = 0; i < mine.size(); ++i) ASSERT_EQ(mine[i], i + 1) << "writer 1 out of order at " << i;
+  for (size_t i = 0; i < other.size(); ++i) ASSERT_EQ(other[i], 100001 + i) << "writer 2 out of order at " << i;
+}
+
+// Write batching holds samples back until a packet fills or the sink is
+// flushed; the end-of-stream marker is flushed by put_eos itself and idle()
+// pushes out a pause's worth of samples.
+TEST(DdsPubSub, WriteBatchingFlushesOnEosAndIdle) {
+  const auto topic = unique_topic("batch");
+  DdsOptions o = opts_for(51);
+  o.write_batch = true;
+  EXPECT_NE(dds::generated_config_xml(o).find("<WriteBatch>true</WriteBatch>"), std::string::npos);
+  DdsSource src(topic, o);
+  DdsSink sink(topic, o);
+  Collector c;
+  src.start(c.handler());
+  ASSERT_TRUE(sink.wait_matched(1, kHang));
+  sink.put("{\"first\":1}", 1);
+  sink.idle();
+  {
+    std::unique_lock lock(c.mu);
+    ASSERT_TRUE(c.cv.wait_for(lock, kHang, [&] { return c.payloads.size() == 1; })) << "idle() did not send";
+  }
+  for (uint64_t s = 2; s <= 1000; ++s) sink.put("{\"s\":" + std::to_string(s) + "}", s);
+  sink.put_eos(1000);  // no flush(): put_eos must send the marker and what precedes it
+  ASSERT_TRUE(c.wait_eos());
+  std::lock_guard lock(c.mu);
+  EXPECT_EQ(c.payloads.size(), 1000u);
+  EXPECT_EQ(c.counters.gaps, 0u);
+  DdsOptions with_file = o;
+  with_file.config_file = "/etc/hostname";
+  EXPECT_THROW(dds::validate(with_file), std::invalid_argument);
 }
 
 TEST(DdsPubSub, PartitionsSeparateTopics) {
