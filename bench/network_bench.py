@@ -2,7 +2,9 @@
 """RV over the network vs local: Timescales files through rvc replay ->
 transport -> rvc monitor, side by side with rvc check on the same file.
 
-  python3 bench/network_bench.py [--transports zenoh-p2p,zenoh-router,dds] [--steps 1000000]
+  python3 bench/network_bench.py [--transports zenoh-p2p,zenoh-router,dds,dds-wb] [--steps 1000000]
+
+(dds-wb: DDS with rvc replay --dds-write-batch, several samples per UDP packet.)
 
 For each file and transport: total time from the first publish (replay's
 started_at) to the last verdict out (monitor's done_at), and the loss
@@ -41,8 +43,10 @@ def free_port():
 class Setup:
     def __init__(self, rvc, name, domain):
         self.rvc, self.name, self.router = rvc, name, None
-        if name == "dds":
+        if name in ("dds", "dds-wb"):
             self.mon = self.rep = ["--domain", str(domain)]
+            if name == "dds-wb":  # replay packs samples into packets (CycloneDDS write batching)
+                self.rep = self.rep + ["--dds-write-batch"]
             self.key = "dds:/rv/bench"
             self.out = "dds:/rv/bench_verdicts"
         else:
@@ -79,7 +83,7 @@ def run_pair(setup, spec, trace, extra_mon=(), extra_rep=(), output="file:/dev/n
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--transports", default="zenoh-p2p,zenoh-router,dds")
+    ap.add_argument("--transports", default="zenoh-p2p,zenoh-router,dds,dds-wb")
     ap.add_argument("--steps", type=int, default=1_000_000)
     ap.add_argument("--reps", type=int, default=3)
     ap.add_argument("--families", default=",".join(FAMILIES))
@@ -92,7 +96,7 @@ def main():
     rvc = os.path.join(args.build, "rvc")
     help_text = subprocess.run([rvc, "monitor", "--help"], capture_output=True, text=True).stdout
     transports = [t for t in args.transports.split(",")
-                  if (t == "dds" and "--domain" in help_text) or (t.startswith("zenoh") and "--connect" in help_text)]
+                  if (t.startswith("dds") and "--domain" in help_text) or (t.startswith("zenoh") and "--connect" in help_text)]
     data = os.path.join(ROOT, "bench", "results", "timescales")
     os.makedirs(data, exist_ok=True)
     rows = []

@@ -73,14 +73,6 @@ struct MonitorCommand {
     });
 
     transport::FrameQueue queue(queue_capacity);
-    // A dds: input may hand samples over on CycloneDDS's receive thread unless
-    // a dds: output could block the engine (and so a full queue, and so that
-    // thread) while it waits for acknowledgements only that thread receives.
-#ifdef RVC_HAVE_DDS
-    bool dds_out = !stats_output.empty() && transport::scheme_of(stats_output) == "dds";
-    for (const auto& uri : outputs) dds_out = dds_out || transport::scheme_of(uri) == "dds";
-    transports.dds.deliver_on_receive_thread = !dds_out;
-#endif
     auto source = transport::open_source(input, transports);
     install_stop_signals();
     source->start([&](const transport::Frame& f) { queue.push(f); });
