@@ -377,7 +377,7 @@ class Deployment:
         if res["monitor"] and res["replay"]:
             res["seconds"] = res["monitor"]["done_at"] - res["replay"]["started_at"]
             res["lost"] = (res["monitor"]["gaps"] + res["monitor"]["duplicates"]
-                           + res["replay"]["sent"] - res["monitor"]["received"])
+                           + res["replay"].get("samples", res["replay"]["sent"]) - res["monitor"]["received"])
         res["verdicts"] = os.path.join(self.out_dir, "verdicts.jsonl")
         return res
 

@@ -32,7 +32,8 @@ use zenoh::bytes::ZBytes;
 use zenoh::key_expr::KeyExpr;
 use zenoh::liveliness::LivelinessToken;
 use zenoh::pubsub::{Publisher, Subscriber};
-use zenoh::qos::CongestionControl;
+use zenoh::qos::{CongestionControl, Priority};
+use zenoh::query::{ConsolidationMode, Query, QueryTarget, Queryable};
 use zenoh::sample::{Sample, SampleKind};
 use zenoh::{Config, Session, Wait};
 
@@ -47,6 +48,15 @@ pub const RVC_ZENOH_EPANIC: c_int = -3;
 /// Liveliness prefix under which rvc subscribers announce themselves, so a
 /// publisher can count them. Zenoh's matching status is only a boolean.
 const ANNOUNCE_PREFIX: &str = "rvc/subscribers";
+
+/// Prefix of the flush queryables of rvc subscribers. A publisher's flush is a
+/// query on FLUSH_PREFIX/<its key>, sent with the data's priority and
+/// congestion control, so it travels behind every sample put before it; each
+/// subscriber answers from its receive path, i.e. after its callback has
+/// taken every one of those samples. Closing a session does not guarantee
+/// that: Zenoh cancels the link's writer mid-batch and drains the rest with a
+/// timeout, so samples still queued for a slow subscriber can be lost.
+const FLUSH_PREFIX: &str = "rvc/flush";
 
 /// How long a `CongestionControl::Block` put may stay blocked before Zenoh
 /// closes the link. Zenoh's default (5 s) turns a briefly stalled monitor into
@@ -532,7 +542,24 @@ impl CallbackTarget {
 pub struct rvc_zenoh_subscriber {
     target: Arc<CallbackTarget>,
     subscriber: Option<Subscriber<()>>,
+    flush: Option<Queryable<()>>,
     token: Option<LivelinessToken>,
+}
+
+/// Answers a publisher's flush query (see FLUSH_PREFIX) unless the subscriber
+/// is being undeclared, in which case later samples would not be delivered.
+fn answer_flush(target: &CallbackTarget, query: &Query) {
+    let active = target.active.read().unwrap_or_else(|p| p.into_inner());
+    if !*active {
+        return;
+    }
+    if let Err(e) = query.reply(query.key_expr().clone(), ZBytes::default()).wait() {
+        tracing_warn(&format!("answering a flush query: {e}"));
+    }
+}
+
+fn tracing_warn(msg: &str) {
+    eprintln!("rvc: zenoh: {msg}");
 }
 
 static ANNOUNCE_COUNTER: AtomicU64 = AtomicU64::new(0);
@@ -574,8 +601,31 @@ pub unsafe extern "C" fn rvc_zenoh_subscriber_declare(
             })
             .wait()
             .map_err(|e| ezenoh(&format!("declaring subscriber on '{ke}'"), e))?;
-        // The token is declared after the subscriber: both travel in order on
-        // the same links, so a publisher that sees the token also routes to it.
+        // The flush queryable and then the token are declared after the
+        // subscriber: all travel in order on the same links, so a publisher
+        // that sees the token also routes samples and flush queries to it.
+        let flush = if announce != 0 {
+            let t = target.clone();
+            let declared = keyexpr(&format!("{FLUSH_PREFIX}/{ke}")).and_then(|fk| {
+                s.session
+                    .declare_queryable(fk)
+                    .callback(move |query: Query| {
+                        let _ = catch_unwind(AssertUnwindSafe(|| answer_flush(&t, &query)));
+                    })
+                    .wait()
+                    .map_err(|e| ezenoh("declaring flush queryable", e))
+            });
+            match declared {
+                Ok(q) => Some(q),
+                Err(e) => {
+                    *target.active.write().unwrap_or_else(|p| p.into_inner()) = false;
+                    drop(subscriber);
+                    return Err(e);
+                }
+            }
+        } else {
+            None
+        };
         let token = if announce != 0 {
             let id = format!(
                 "{}-{}",
@@ -604,6 +654,7 @@ pub unsafe extern "C" fn rvc_zenoh_subscriber_declare(
         *out = Box::into_raw(Box::new(rvc_zenoh_subscriber {
             target,
             subscriber: Some(subscriber),
+            flush,
             token,
         }));
         Ok(RVC_ZENOH_OK)
@@ -625,6 +676,11 @@ pub unsafe extern "C" fn rvc_zenoh_subscriber_undeclare(sub: *mut rvc_zenoh_subs
             t.undeclare()
                 .wait()
                 .map_err(|e| ezenoh("undeclaring liveliness token", e))?;
+        }
+        if let Some(q) = sub.flush.take() {
+            q.undeclare()
+                .wait()
+                .map_err(|e| ezenoh("undeclaring flush queryable", e))?;
         }
         if let Some(s) = sub.subscriber.take() {
             s.undeclare()
@@ -651,6 +707,8 @@ type Shared = Arc<(Mutex<MatchState>, Condvar)>;
 
 pub struct rvc_zenoh_publisher {
     publisher: Publisher<'static>,
+    session: Session,
+    flush_key: KeyExpr<'static>,
     state: Shared,
     announcements: Option<Subscriber<()>>,
 }
@@ -719,6 +777,8 @@ pub unsafe extern "C" fn rvc_zenoh_publisher_declare(
 
         *out = Box::into_raw(Box::new(rvc_zenoh_publisher {
             publisher,
+            session: s.session.clone(),
+            flush_key: keyexpr(&format!("{FLUSH_PREFIX}/{ke}"))?,
             state,
             announcements: Some(announcements),
         }));
@@ -821,6 +881,50 @@ pub unsafe extern "C" fn rvc_zenoh_publisher_wait_matched(
                 .wait_timeout_while(g, cap, |s| s.generation == generation)
                 .unwrap_or_else(|e| e.into_inner());
         }
+    })
+}
+
+/// Waits until every rvc subscriber reachable now has taken every sample this
+/// publisher put before the call (see FLUSH_PREFIX). `*confirmed` receives the
+/// number of subscribers that answered; non-rvc subscribers cannot answer.
+/// Returns 1 when the query completed, 0 when `timeout_ms` ran out first.
+#[no_mangle]
+pub unsafe extern "C" fn rvc_zenoh_publisher_flush(
+    p: *const rvc_zenoh_publisher,
+    timeout_ms: u64,
+    confirmed: *mut usize,
+) -> c_int {
+    guard(|| {
+        let p = handle(p, "publisher")?;
+        let deadline = Instant::now() + Duration::from_millis(timeout_ms);
+        let replies = p
+            .session
+            .get(p.flush_key.clone())
+            .target(QueryTarget::All)
+            .consolidation(ConsolidationMode::None)
+            .congestion_control(CongestionControl::Block)
+            .priority(Priority::default())
+            // Zenoh's own query timeout comes later, so the deadline below
+            // tells a timeout from completion.
+            .timeout(Duration::from_millis(timeout_ms) + Duration::from_secs(1))
+            .wait()
+            .map_err(|e| ezenoh("flush query", e))?;
+        let mut n = 0usize;
+        let complete = loop {
+            match replies.recv_deadline(deadline) {
+                Ok(Some(reply)) => {
+                    if reply.result().is_ok() {
+                        n += 1;
+                    }
+                }
+                Ok(None) => break false, // timed out
+                Err(_) => break true,    // all queryables answered (or none exists)
+            }
+        };
+        if let Some(out) = unsafe { confirmed.as_mut() } {
+            *out = n;
+        }
+        Ok(complete as c_int)
     })
 }
 

@@ -114,6 +114,11 @@ int rvc_zenoh_publisher_matching(const rvc_zenoh_publisher* p, int* matching, si
  * matching status (works with any subscriber); n > 1 also needs n announced
  * rvc subscribers. */
 int rvc_zenoh_publisher_wait_matched(const rvc_zenoh_publisher* p, size_t n, uint64_t timeout_ms);
+/* Flush barrier: waits until every rvc subscriber reachable now has taken
+ * every sample put before the call (a query that travels behind the data,
+ * answered by the subscribers' receive path). *confirmed (may be NULL) gets
+ * the number that answered. 1 when complete, 0 on timeout, <0 on error. */
+int rvc_zenoh_publisher_flush(const rvc_zenoh_publisher* p, uint64_t timeout_ms, size_t* confirmed);
 int rvc_zenoh_publisher_undeclare(rvc_zenoh_publisher* p);
 
 #ifdef __cplusplus

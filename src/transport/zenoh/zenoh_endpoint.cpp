@@ -44,7 +44,7 @@ void ZenohSource::stop() {
 // ---- ZenohSink -------------------------------------------------------------
 
 ZenohSink::ZenohSink(std::shared_ptr<ZenohSession> session, std::string keyexpr, bool express)
-    : session_(session), pub_(std::move(session), keyexpr, express) {}
+    : session_(session), keyexpr_(keyexpr), pub_(std::move(session), keyexpr, express) {}
 
 void ZenohSink::put(std::string_view payload, uint64_t seq) {
   const auto att = encode_seq_attachment(seq, false);
@@ -54,6 +54,17 @@ void ZenohSink::put(std::string_view payload, uint64_t seq) {
 void ZenohSink::put_eos(uint64_t last_seq) {
   const auto att = encode_seq_attachment(last_seq, true);
   pub_.put({}, std::string_view(reinterpret_cast<const char*>(att.data()), att.size()));
+}
+
+void ZenohSink::flush() {
+  const std::size_t announced = pub_.announced_subscribers();
+  const auto confirmed = pub_.flush(std::chrono::seconds(60));
+  if (!confirmed)
+    std::fprintf(stderr, "rvc: zenoh: flush of '%s' not confirmed within 60 s (a subscriber is stalled?)\n",
+                 keyexpr_.c_str());
+  else if (*confirmed < announced)
+    std::fprintf(stderr, "rvc: zenoh: flush of '%s' confirmed by %zu of %zu rvc subscribers\n", keyexpr_.c_str(),
+                 *confirmed, announced);
 }
 
 bool ZenohSink::wait_matched(size_t n, std::chrono::milliseconds timeout) {

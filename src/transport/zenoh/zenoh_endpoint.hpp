@@ -41,12 +41,16 @@ class ZenohSink : public Sink {
   void put_eos(uint64_t last_seq) override;
   // n <= 1: any subscriber (also non-rvc ones); n > 1: n rvc subscribers.
   bool wait_matched(size_t n, std::chrono::milliseconds timeout) override;
-  // Nothing to do: Zenoh sends queued samples when the session closes.
-  void flush() override {}
+  // Waits (up to 60 s) until every announced rvc subscriber has taken every
+  // sample put so far: closing the session right after the last put can lose
+  // samples still queued for a slow subscriber. Warns on stderr when fewer
+  // subscribers answered than had announced themselves, or on timeout.
+  void flush() override;
   ZenohPublisher& publisher() { return pub_; }
 
  private:
   std::shared_ptr<ZenohSession> session_;
+  std::string keyexpr_;
   ZenohPublisher pub_;
 };
 

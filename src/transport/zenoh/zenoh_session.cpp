@@ -196,6 +196,15 @@ std::size_t ZenohPublisher::announced_subscribers() const {
   return n;
 }
 
+std::optional<std::size_t> ZenohPublisher::flush(std::chrono::milliseconds timeout) {
+  const auto ms = timeout.count() < 0 ? 0 : static_cast<uint64_t>(timeout.count());
+  size_t confirmed = 0;
+  const int rc = rvc_zenoh_publisher_flush(pub_, ms, &confirmed);
+  check(rc, "flush");
+  if (rc == 0) return std::nullopt;
+  return confirmed;
+}
+
 bool ZenohPublisher::wait_matched(std::size_t n, std::chrono::milliseconds timeout) {
   const auto ms = timeout.count() < 0 ? 0 : static_cast<uint64_t>(timeout.count());
   int rc = rvc_zenoh_publisher_wait_matched(pub_, n, ms);

@@ -108,6 +108,10 @@ class ZenohPublisher {
   std::size_t announced_subscribers() const;
   // n <= 1: any subscriber; n > 1: n announced rvc subscribers. False on timeout.
   bool wait_matched(std::size_t n, std::chrono::milliseconds timeout);
+  // Flush barrier: waits until every rvc subscriber reachable now has taken
+  // every sample put before (see rvc_zenoh_publisher_flush). Returns how many
+  // answered; nullopt when `timeout` ran out first.
+  std::optional<std::size_t> flush(std::chrono::milliseconds timeout);
 
  private:
   std::shared_ptr<ZenohSession> session_;

@@ -293,6 +293,52 @@ TEST(ZenohTransport, SlowSubscriberLosesNothing) {
   EXPECT_EQ(counters.last_seq, kN);
 }
 
+// flush() is a barrier: when it returns, a slow subscriber in another session
+// has taken every sample put before it, so the publisher may close its session
+// at once. (Closing right after the last put lost samples still queued for a
+// slow subscriber: Zenoh drains a closing link only with a timeout.)
+TEST(ZenohTransport, FlushWaitsUntilEverySampleIsTaken) {
+  const int port = free_port();
+  auto a = ZenohSession::open(listener_opts(port));
+  std::atomic<uint64_t> taken{0};
+  ZenohSource source(a, "rvc/test/flush");
+  source.start([&](const Frame& f) {
+    if (f.eos) return;
+    std::this_thread::sleep_for(200us);  // ~0.6 s for all of them
+    taken.fetch_add(1);
+  });
+  constexpr uint64_t kN = 3000;
+  {
+    auto b = ZenohSession::open(connector_opts(port));
+    ZenohSink sink(b, "rvc/test/flush");
+    ASSERT_TRUE(sink.wait_matched(1, kHangGuard));
+    ASSERT_TRUE(sink.publisher().wait_matched(1, kHangGuard));
+    const std::string payload(4096, 'f');
+    for (uint64_t i = 1; i <= kN; ++i) sink.put(payload, i);
+    EXPECT_LT(taken.load(), kN) << "the subscriber was not slower than the publisher: the test proves nothing";
+    auto confirmed = sink.publisher().flush(kHangGuard);
+    ASSERT_TRUE(confirmed.has_value());
+    EXPECT_EQ(*confirmed, 1u);
+    EXPECT_EQ(taken.load(), kN);  // before the session closes
+  }
+  source.stop();
+  EXPECT_EQ(taken.load(), kN);
+}
+
+// A flush with no rvc subscriber (nobody to answer) returns at once.
+TEST(ZenohTransport, FlushWithoutRvcSubscribersReturns) {
+  const int port = free_port();
+  auto a = ZenohSession::open(listener_opts(port));
+  auto b = ZenohSession::open(connector_opts(port));
+  ZenohSubscriber plain(a, "rvc/test/flush_plain", [](const ZenohSample&) {}, /*announce=*/false);
+  ZenohSink sink(b, "rvc/test/flush_plain");
+  ASSERT_TRUE(sink.wait_matched(1, kHangGuard));
+  sink.put("{}", 1);
+  auto confirmed = sink.publisher().flush(kHangGuard);
+  ASSERT_TRUE(confirmed.has_value());
+  EXPECT_EQ(*confirmed, 0u);
+}
+
 // Samples from two remote sessions arrive on two links, hence possibly on
 // two Zenoh threads; ZenohSource still never runs its handler twice at once.
 TEST(ZenohTransport, HandlerCallsNeverOverlap) {
