@@ -64,10 +64,17 @@ def root_cmd(cmd):
 
 
 def compose_command():
-    """`docker compose` (v2) when present, else docker-compose (1.29)."""
-    for cmd in (["docker", "compose"], ["docker-compose"]):
+    """`docker compose` (v2) when present, else docker-compose (1.29). RVC_COMPOSE=v1 or v2 insists on one."""
+    want = os.environ.get("RVC_COMPOSE", "")
+    cands = {"v1": [["docker-compose"]], "v2": [["docker", "compose"]]}.get(
+        want, [["docker", "compose"], ["docker-compose"]])
+    for cmd in cands:
         if shutil.which(cmd[0]) and subprocess.run(cmd + ["version"], capture_output=True).returncode == 0:
             return cmd
+    if want in ("v1", "v2"):
+        raise Unsupported("RVC_COMPOSE=%s but %s is not installed (%s)" % (
+            want, "docker-compose" if want == "v1" else "`docker compose`",
+            "scripts/docker-setup.sh" if want == "v1" else "scripts/compose-v2.sh"))
     raise Unsupported("neither `docker compose` nor docker-compose is installed (scripts/docker-setup.sh)")
 
 
