@@ -87,6 +87,15 @@ def legend(fig, axes):
                frameon=False)
 
 
+def md_table(w, head, rows):
+    """A markdown table, first column as label, all columns right-aligned, then a blank line."""
+    w("| " + " | ".join(head) + " |")
+    w("|---:|" + "---:|" * (len(head) - 1))
+    for cells in rows:
+        w("| " + " | ".join(cells) + " |")
+    w("")
+
+
 def plot(rows, settings, systems, img_dir, prefix="baseline"):
     """PNG plots: throughput vs size and latency vs rate, one panel per
     network setting, one line per system. Returns the files written (none
@@ -276,16 +285,11 @@ def markdown(rows, settings, systems, meta, images, notes):
         if not sizes:
             continue
         w(f"### {st.label}\n")
-        w("| size | " + " | ".join(labels[c] for c in cols) + " |")
-        w("|---:|" + "---:|" * len(cols))
-        for size in sizes:
-            cells = []
-            for c in cols:
-                r = tput.get((st.name, c, size, ""))
-                cells.append("–" if r is None else f"{fmt_mps(num(r['msgs_per_s']))} ({num(r['mbps']):.0f} Mb/s)"
-                             + (f" **lost {r['lost']}**" if r["lost"] not in ("", "0", 0) else ""))
-            w(f"| {human_size(size)} | " + " | ".join(cells) + " |")
-        w("")
+        def tput_cell(r):
+            return "–" if r is None else (f"{fmt_mps(num(r['msgs_per_s']))} ({num(r['mbps']):.0f} Mb/s)"
+                                          + (f" **lost {r['lost']}**" if r["lost"] not in ("", "0", 0) else ""))
+        md_table(w, ["size"] + [labels[c] for c in cols],
+                 [[human_size(size)] + [tput_cell(tput.get((st.name, c, size, ""))) for c in cols] for size in sizes])
     # -- ratios
     w("## rvc perf / ddsperf\n")
     w("Throughput ratios (messages/s of rvc perf divided by ddsperf's at the same size and setting; "
@@ -297,14 +301,12 @@ def markdown(rows, settings, systems, meta, images, notes):
         cols = [c for c in ("dds", "dds-batch", "zenoh", "dds-zenoh") if any(k[0] == st.name and k[1] == c
                                                                             for k in tput)]
         w(f"### {st.label}\n")
-        w("| size | " + " | ".join(labels[c] + " / ddsperf" for c in cols) + " |")
-        w("|---:|" + "---:|" * len(cols))
-        for size in sizes:
+        def ratio_cell(c, size):
             d = num(tput[(st.name, "ddsperf", size, "")]["msgs_per_s"])
-            cells = [fmt_ratio(ratio(num(tput[(st.name, c, size, "")]["msgs_per_s"]), d))
-                     if (st.name, c, size, "") in tput else "–" for c in cols]
-            w(f"| {human_size(size)} | " + " | ".join(cells) + " |")
-        w("")
+            r = tput.get((st.name, c, size, ""))
+            return "–" if r is None else fmt_ratio(ratio(num(r["msgs_per_s"]), d))
+        md_table(w, ["size"] + [labels[c] + " / ddsperf" for c in cols],
+                 [[human_size(size)] + [ratio_cell(c, size) for c in cols] for size in sizes])
     # -- latency
     w("## Latency (one-way = round trip / 2)\n")
     for img in images:
@@ -318,16 +320,11 @@ def markdown(rows, settings, systems, meta, images, notes):
         sizes = sorted({k[2] for k in lat if k[0] == st.name})
         w(f"### {st.label} ({', '.join(human_size(s) for s in sizes)} payload)\n")
         w("p50 / p99 / max per rate:\n")
-        w("| rate | " + " | ".join(labels[c] for c in cols) + " |")
-        w("|---:|" + "---:|" * len(cols))
-        for rate in rates:
-            cells = []
-            for c in cols:
-                r = next((v for k, v in lat.items() if k[0] == st.name and k[1] == c and k[3] == rate), None)
-                cells.append("–" if r is None else
-                             f"{fmt_us(num(r['p50_us']))} / {fmt_us(num(r['p99_us']))} / {fmt_us(num(r['max_us']))}")
-            w(f"| {human_rate(rate)} | " + " | ".join(cells) + " |")
-        w("")
+        def lat_cell(c, rate):
+            r = next((v for k, v in lat.items() if k[0] == st.name and k[1] == c and k[3] == rate), None)
+            return "–" if r is None else f"{fmt_us(num(r['p50_us']))} / {fmt_us(num(r['p99_us']))} / {fmt_us(num(r['max_us']))}"
+        md_table(w, ["rate"] + [labels[c] for c in cols],
+                 [[human_rate(rate)] + [lat_cell(c, rate) for c in cols] for rate in rates])
     failed = [r for r in rows if str(r["ok"]) != "True"]
     if failed or notes:
         w("## Not measured / notes\n")

@@ -118,14 +118,7 @@ struct ReplayCommand {
       if (len == 0) continue;
       ++events;
       seq = events;
-      if (hz > 0) {
-        const auto due = t0 + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                                   std::chrono::duration<double>(static_cast<double>(seq - 1) / hz));
-        if (due > std::chrono::steady_clock::now()) {
-          sink->idle();  // what write batching holds back goes out before the pause
-          std::this_thread::sleep_until(due);
-        }
-      }
+      if (hz > 0) std::this_thread::sleep_until(t0 + std::chrono::duration<double>(static_cast<double>(seq - 1) / hz));
       if (batch <= 1) {
         send(std::string_view(line, len));
       } else {

@@ -56,12 +56,6 @@ class FrameQueue {
     return true;
   }
 
-  // Nothing queued right now (a hint: producers may add at any time).
-  bool empty() {
-    std::lock_guard<std::mutex> lock(mutex_);
-    return incoming_count_ == 0;
-  }
-
   // Wakes everyone; later pushes are dropped (used only when shutting down).
   void close() {
     std::lock_guard<std::mutex> lock(mutex_);

@@ -554,15 +554,23 @@ fn answer_flush(target: &CallbackTarget, query: &Query) {
         return;
     }
     if let Err(e) = query.reply(query.key_expr().clone(), ZBytes::default()).wait() {
-        tracing_warn(&format!("answering a flush query: {e}"));
+        warn(&format!("answering a flush query: {e}"));
     }
 }
 
-fn tracing_warn(msg: &str) {
+fn warn(msg: &str) {
     eprintln!("rvc: zenoh: {msg}");
 }
 
 static ANNOUNCE_COUNTER: AtomicU64 = AtomicU64::new(0);
+
+/// A declaration after the subscriber failed: the caller frees ctx on error,
+/// so fence callbacks before the subscriber goes, and pass the error on.
+fn abandon(target: &CallbackTarget, subscriber: Subscriber<()>, e: FfiError) -> FfiError {
+    *target.active.write().unwrap_or_else(|p| p.into_inner()) = false;
+    drop(subscriber);
+    e
+}
 
 fn keyexpr(s: &str) -> FfiResult<KeyExpr<'static>> {
     KeyExpr::autocanonize(s.to_owned()).map_err(|e| einval(format!("key expression '{s}': {e}")))
@@ -617,11 +625,7 @@ pub unsafe extern "C" fn rvc_zenoh_subscriber_declare(
             });
             match declared {
                 Ok(q) => Some(q),
-                Err(e) => {
-                    *target.active.write().unwrap_or_else(|p| p.into_inner()) = false;
-                    drop(subscriber);
-                    return Err(e);
-                }
+                Err(e) => return Err(abandon(&target, subscriber, e)),
             }
         } else {
             None
@@ -641,12 +645,7 @@ pub unsafe extern "C" fn rvc_zenoh_subscriber_declare(
             });
             match declared {
                 Ok(token) => Some(token),
-                Err(e) => {
-                    // The caller frees ctx on error: fence callbacks first.
-                    *target.active.write().unwrap_or_else(|p| p.into_inner()) = false;
-                    drop(subscriber);
-                    return Err(e);
-                }
+                Err(e) => return Err(abandon(&target, subscriber, e)),
             }
         } else {
             None

@@ -27,10 +27,10 @@ struct DdsOptions {
   std::vector<std::string> peers;  // unicast discovery peers; default 127.0.0.1 when interface is loopback
   std::string config_file;         // user's CycloneDDS XML: replaces the generated configuration entirely
   std::string trace_file;          // CycloneDDS trace (config, discovery, info) written to this file
-  // CycloneDDS Internal/WriteBatch: a writer packs several samples into one
-  // packet and sends when it is full or flushed. Sinks flush on idle(),
-  // flush() and after the end-of-stream marker, so nothing waits for long;
-  // worth it for bursts of small samples (rvc replay --rate max).
+  // CycloneDDS Internal/WriteBatch: a writer packs the samples of a burst
+  // into one packet. Sinks also flush explicitly after the end-of-stream
+  // marker, in flush() and idle(). Worth it for bursts of small samples
+  // (rvc replay --rate max).
   bool write_batch = false;
   // Set by commands, not by a flag: sources call the handler directly on
   // CycloneDDS's receive thread (a data-available listener) instead of

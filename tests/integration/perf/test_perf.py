@@ -66,13 +66,17 @@ def transport_flags(transport, side, port, domain):
     return ["--domain", str(domain)]
 
 
+def perf_pair(transport, domain, key, server, client, client_args):
+    """`rvc perf SERVER` (side b, listening) and `rvc perf CLIENT` (side a) on one key."""
+    port = free_port()
+    return pair([RVC, "perf", server, "-t", transport, "--key", key] + transport_flags(transport, "b", port, domain),
+                [RVC, "perf", client, "-t", transport, "--key", key] + client_args
+                + transport_flags(transport, "a", port, domain))
+
+
 @pytest.mark.parametrize("transport,domain", [("zenoh", 0), ("dds", 21)])
 def test_pub_sub_counts_every_message(transport, domain):
-    port = free_port()
-    pub, prc, sub, src = pair(
-        [RVC, "perf", "sub", "-t", transport, "--key", "rvc_perf_t1"] + transport_flags(transport, "b", port, domain),
-        [RVC, "perf", "pub", "-t", transport, "--key", "rvc_perf_t1", "--size", "1k", "--duration", "1"]
-        + transport_flags(transport, "a", port, domain))
+    pub, prc, sub, src = perf_pair(transport, domain, "rvc_perf_t1", "sub", "pub", ["--size", "1k", "--duration", "1"])
     assert prc == 0 and src == 0
     for k in ("transport", "size", "msgs_per_s", "mbps", "lost", "sent", "received"):
         assert k in sub and k in pub
@@ -83,11 +87,7 @@ def test_pub_sub_counts_every_message(transport, domain):
 
 @pytest.mark.parametrize("transport,domain", [("zenoh", 0), ("dds", 22)])
 def test_ping_pong_reports_latency(transport, domain):
-    port = free_port()
-    ping, prc, pong, qrc = pair(
-        [RVC, "perf", "pong", "-t", transport, "--key", "rvc_perf_t2"] + transport_flags(transport, "b", port, domain),
-        [RVC, "perf", "ping", "-t", transport, "--key", "rvc_perf_t2", "--rate", "200", "--duration", "1"]
-        + transport_flags(transport, "a", port, domain))
+    ping, prc, pong, qrc = perf_pair(transport, domain, "rvc_perf_t2", "pong", "ping", ["--rate", "200", "--duration", "1"])
     assert prc == 0 and qrc == 0
     for k in ("transport", "size", "rate", "count", "mean_us", "min_us", "p50_us", "p90_us", "p99_us", "max_us"):
         assert k in ping
