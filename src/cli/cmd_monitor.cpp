@@ -28,6 +28,8 @@ struct MonitorCommand {
   bool exit_on_eos = false;
   double stats_interval = 0;
   size_t queue_capacity = 1 << 14;
+  size_t wait_subscribers = 0;  // per network output, before subscribing to the input
+  double wait_timeout = 10;
   double first_at = 0;  // wall clock when the first message arrived
 
   // Wall-clock seconds (shared by processes on one host): benchmarks compute
@@ -58,6 +60,19 @@ struct MonitorCommand {
     for (const auto& uri : outputs) sinks.push_back(transport::open_sink(uri, transports));
     std::unique_ptr<transport::Sink> stats_sink;
     if (!stats_output.empty()) stats_sink = transport::open_sink(stats_output, transports);
+    // Verdicts written before a subscriber has matched are lost (volatile
+    // QoS), and the first verdict follows the first input message at once:
+    // wait for the verdict subscribers before subscribing to the input.
+    for (size_t i = 0; i < sinks.size() && wait_subscribers > 0; ++i) {
+      if (transport::scheme_of(outputs[i]) == "file") continue;
+      std::fprintf(stderr, "rvc monitor: waiting for %zu subscriber%s on %s ...\n", wait_subscribers,
+                   wait_subscribers == 1 ? "" : "s", outputs[i].c_str());
+      if (!sinks[i]->wait_matched(wait_subscribers, std::chrono::milliseconds(static_cast<long>(wait_timeout * 1000)))) {
+        std::fprintf(stderr, "rvc: no subscriber matched on %s within %.1f s (--wait-timeout)\n", outputs[i].c_str(),
+                     wait_timeout);
+        return kUsage;
+      }
+    }
 
     uint64_t verdicts = 0;
     std::string line;
@@ -89,20 +104,10 @@ struct MonitorCommand {
       std::fprintf(stderr, "%s\n", js.c_str());
       if (stats_sink) stats_sink->put(js, 0);
     };
-    // Sinks get idle() when the input pauses, so buffered verdicts (file
-    // buffers, DDS write batches) go out within about a millisecond of the
-    // last input, but not after every small batch of a busy stream.
-    auto last_idle = std::chrono::steady_clock::now();
-    bool idle_due = false;
-    auto idle_sinks = [&] {
-      for (auto& s : sinks) s->idle();
-      last_idle = std::chrono::steady_clock::now();
-      idle_due = false;
-    };
     while (!stop_requested() && !(eos && exit_on_eos)) {
-      if (!queue.pop_batch(batch, count, idle_due ? 1 : 100)) break;
+      if (!queue.pop_batch(batch, count, 100)) break;
       if (count == 0) {
-        idle_sinks();
+        for (auto& s : sinks) s->idle();
         continue;
       }
       if (count > 0 && first_at == 0) first_at = wall_now();
@@ -115,12 +120,6 @@ struct MonitorCommand {
         }
         counters.on_seq(f.seq);
         pipeline.feed(f.payload, f.seq ? f.seq : counters.received);
-      }
-      if (queue.empty()) {
-        if (std::chrono::steady_clock::now() - last_idle >= std::chrono::milliseconds(1))
-          idle_sinks();
-        else
-          idle_due = true;
       }
       if (stats_requested()) publish_stats();
       if (stats_interval > 0 &&
@@ -164,6 +163,10 @@ Runner register_monitor(CLI::App& app) {
   sub->add_flag("--exit-on-eos", cmd->exit_on_eos, "Exit after the publisher's end-of-stream marker");
   sub->add_option("--stats-interval", cmd->stats_interval, "Print counters every S seconds (also on SIGUSR1)");
   sub->add_option("--stats-output", cmd->stats_output, "Also publish the counters (JSON) to this endpoint");
+  sub->add_option("--wait-subscribers", cmd->wait_subscribers,
+                  "Before reading the input, wait for this many subscribers on each zenoh:/dds: output")
+      ->capture_default_str();
+  sub->add_option("--wait-timeout", cmd->wait_timeout, "Seconds to wait for them")->capture_default_str();
   sub->add_option("--queue", cmd->queue_capacity, "Messages buffered between transport and engine")->capture_default_str();
   transport::add_transport_options(*sub, cmd->transports);
   sub->footer(

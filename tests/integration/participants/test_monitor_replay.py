@@ -188,8 +188,11 @@ def test_verdicts_reach_a_second_monitor(rvc, tmp_path, transport):
     second = subprocess.Popen([rvc, "monitor", "--all", "--spec", "{value} or not {value}", "--input", net.out_topic,
                                "--output", f"file:{verdicts_seen}", "--exit-on-eos", *net.monitor_flags],
                               stderr=subprocess.PIPE, text=True)
+    # --wait-subscribers: without it the first verdicts could go out before
+    # the second monitor's reader matched (volatile QoS), losing its EOS.
     first = subprocess.Popen([rvc, "monitor", "--all", "--spec", "{p}", "--input", net.topic,
-                              "--output", net.out_topic, "--exit-on-eos", *net.monitor_flags],
+                              "--output", net.out_topic, "--exit-on-eos", "--wait-subscribers", "1",
+                              "--wait-timeout", "30", *net.monitor_flags],
                              stderr=subprocess.PIPE, text=True)
     rep = subprocess.run([rvc, "replay", str(trace), "--to", net.topic, *net.replay_flags], capture_output=True,
                          text=True, timeout=60)

@@ -292,3 +292,40 @@ def test_replay_reaches_a_python_dds_subscriber(rvc, tmp_path, dds_env):
     wait_for(collect, "all messages and the end-of-stream marker")
     assert got[:len(lines)] == lines
     assert got[len(lines)].startswith("\x04rvc-eos")  # the documented marker, seen by a plain ROS 2 reader
+
+
+def test_replay_with_write_batching_delivers_at_the_publish_rate(rvc, tmp_path, dds_env):
+    """--dds-write-batch packs samples into packets, but a sample published
+    before a pause must not wait for the next one: at a set --rate a subscriber
+    in another process gets every sample when it is published, not all of them
+    with the last packet. (In one process CycloneDDS delivers locally and never
+    batches, so this needs two.)"""
+    from cyclonedds.domain import DomainParticipant
+    from cyclonedds.sub import DataReader
+    from cyclonedds.topic import Topic
+    String_ = dds_env
+    domain = 180 + os.getpid() % 20
+    lines = messages(6)
+    trace = tmp_path / "t.jsonl"
+    trace.write_text("\n".join(lines) + "\n")
+    dp = DomainParticipant(domain)
+    reader = DataReader(dp, Topic(dp, "rt/rvc_py/batched", String_), qos=dds_qos())
+    rep = subprocess.Popen([rvc, "replay", str(trace), "--to", "dds:/rvc_py/batched", "--domain", str(domain),
+                            "--rate", "4", "--dds-write-batch", "--no-progress"],
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    got, arrived = [], []
+
+    def collect():
+        for s in reader.take(N=100):
+            got.append(s.data)
+            arrived.append(time.monotonic())
+        return len(got) >= len(lines) + 1
+    try:
+        wait_for(collect, "all messages and the end-of-stream marker")
+    finally:
+        out, err = rep.communicate(timeout=HANG_GUARD)
+    assert rep.returncode == 0, err
+    assert got[:len(lines)] == lines and got[len(lines)].startswith("\x04rvc-eos")
+    # Published 0.25 s apart (1.25 s from first to last): held back in one
+    # packet until the end of stream they would arrive within milliseconds.
+    assert arrived[len(lines) - 1] - arrived[0] > 0.5, [round(t - arrived[0], 3) for t in arrived]
