@@ -21,6 +21,10 @@
 include_guard(GLOBAL)
 
 set(RVC_CARGO_JOBS 2 CACHE STRING "Parallel jobs for cargo builds")
+# Several build trees (release, sanitizers, git worktrees) can share one cargo
+# target dir so the Zenoh crate compiles once; cargo locks it while it builds.
+set(RVC_CARGO_TARGET_DIR "$ENV{RVC_CARGO_TARGET_DIR}" CACHE PATH
+    "cargo target dir (default: <build tree>/cargo-target)")
 
 find_program(CARGO_EXECUTABLE cargo
   HINTS "$ENV{CARGO_HOME}/bin" "$ENV{HOME}/.cargo/bin"
@@ -38,7 +42,10 @@ function(rvc_cargo_staticlib target)
   endif()
 
   get_filename_component(manifest_dir "${ARG_MANIFEST_DIR}" ABSOLUTE)
-  set(target_dir "${CMAKE_BINARY_DIR}/cargo-target")
+  set(target_dir "${RVC_CARGO_TARGET_DIR}")
+  if(NOT target_dir)
+    set(target_dir "${CMAKE_BINARY_DIR}/cargo-target")
+  endif()
   set(lib "${target_dir}/release/lib${ARG_LIB_NAME}.a")
   set(stamp "${CMAKE_CURRENT_BINARY_DIR}/${target}.cargo-stamp")
 

@@ -7,14 +7,12 @@
 #include <string>
 #include <string_view>
 
+#include "io/json_writer.hpp"
+
 namespace rvc::io {
 
 // Appends one verdict line (with '\n') to `out`.
 void append_verdict(std::string& out, double time, bool discrete, std::string_view property, bool value);
-// Appends `s` as a JSON string literal, escaping what JSON requires.
-void append_json_string(std::string& out, std::string_view s);
-// Appends a number in the shortest round-trip form (integers without ".0").
-void append_number(std::string& out, double v);
 
 // Buffered writer to a FILE*: verdicts are small and frequent.
 class VerdictWriter {
