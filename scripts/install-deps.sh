@@ -14,6 +14,7 @@ APT_PACKAGES=(
   cyclonedds-dev cyclonedds-tools
   python3 python3-pip
   iproute2 time
+  clang libclang-rt-14-dev  # libFuzzer harnesses and the sanitizer tiers (tests/fuzz)
 )
 # Zenoh is a Rust crate: the locked Zenoh dependencies need cargo >= 1.89; Debian's cargo-web (1.96)
 # is used when the machine has none.
