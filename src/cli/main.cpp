@@ -67,8 +67,10 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "rvc: %s\n", e.what());
     return kUsage;
   } catch (const std::exception& e) {
+    // Anything else happened while running (an output that cannot be written,
+    // a transport that failed): a runtime failure, not a usage error.
     std::fprintf(stderr, "rvc: error: %s\n", e.what());
-    return kUsage;
+    return kRuntime;
   }
   return kUsage;
 }
