@@ -6,10 +6,12 @@
 #include <string>
 #include <vector>
 
-#include "cli/pipeline.hpp"
+#include "runtime/pipeline.hpp"
 #include "engine/checker.hpp"
 
 namespace rvc::cli {
+
+using runtime::PipelineOptions;
 
 struct CheckOptions {
   std::vector<std::string> specs;

@@ -1,5 +1,6 @@
 // rvc check: run properties over a JSON-lines trace (file or stdin), print
-// verdicts as JSON lines, and exit non-zero if a property was violated.
+// verdicts as JSON lines, and exit non-zero if a property was violated. Runs
+// on the same runtime as `rvc monitor` (src/runtime).
 #include <fcntl.h>
 #include <unistd.h>
 
@@ -8,10 +9,13 @@
 
 #include "cli/check_options.hpp"
 #include "cli/commands.hpp"
-#include "io/verdict_writer.hpp"
+#include "runtime/check_stream.hpp"
+#include "transport/file_endpoint.hpp"
 
 namespace rvc::cli {
 namespace {
+
+std::string strip_file_scheme(const std::string& uri) { return uri.rfind("file:", 0) == 0 ? uri.substr(5) : uri; }
 
 struct CheckCommand {
   CheckOptions check;
@@ -21,7 +25,11 @@ struct CheckCommand {
 
   int run() {
     auto properties = check.properties();
-    std::string path = input.rfind("file:", 0) == 0 ? input.substr(5) : input;
+    const std::string path = strip_file_scheme(input), opath = strip_file_scheme(output);
+    if (path != "-" && opath != "-" && runtime::same_regular_file(path, opath)) {
+      std::fprintf(stderr, "rvc: --output '%s' is the trace being read: refusing to overwrite it\n", opath.c_str());
+      return kUsage;
+    }
     int fd = 0;
     if (path != "-") {
       fd = ::open(path.c_str(), O_RDONLY);
@@ -30,32 +38,16 @@ struct CheckCommand {
         return kUsage;
       }
     }
-    std::FILE* out = stdout;
-    std::unique_ptr<std::FILE, int (*)(std::FILE*)> owned(nullptr, &std::fclose);
-    if (output != "-") {
-      std::string opath = output.rfind("file:", 0) == 0 ? output.substr(5) : output;
-      owned.reset(std::fopen(opath.c_str(), "w"));
-      if (!owned) {
-        std::fprintf(stderr, "rvc: cannot write '%s'\n", opath.c_str());
-        return kUsage;
-      }
-      out = owned.get();
-    }
-    // Reading stdin interactively: show each verdict as soon as it is known.
-    io::VerdictWriter writer(out, !check.dense, path == "-" && isatty(0));
-    Pipeline pipeline(properties, check.pipeline_options(),
-                      [&](const engine::Verdict& v) { writer.write(v.time, v.property, v.value); });
+    std::vector<std::unique_ptr<transport::Sink>> sinks;
+    sinks.push_back(std::make_unique<transport::FileSink>(opath));
+    runtime::VerdictOutputs outputs(std::move(sinks), !check.dense);
+    runtime::Pipeline pipeline(properties, check.pipeline_options(),
+                               [&](const engine::Verdict& v) { outputs.put(v); });
     io::ReaderOptions ropts;
     ropts.max_line_bytes = check.max_message_size;
-    std::string error;
-    bool ok = io::read_jsonl(fd, pipeline, ropts, error);
+    // Reading stdin: show each verdict as soon as it is known.
+    runtime::Outcome outcome = runtime::check_stream(fd, pipeline, outputs, ropts, path == "-");
     if (fd != 0) ::close(fd);
-    writer.flush();
-    pipeline.finish_report();
-    if (!ok) {
-      std::fprintf(stderr, "rvc: %s\n", error.c_str());
-      return kUsage;
-    }
     const auto& s = pipeline.stats();
     if (summary || s.rejected > 0) {
       std::fprintf(stderr, "rvc: %llu messages checked, %llu rejected, %llu warnings; %s\n",
@@ -63,8 +55,7 @@ struct CheckCommand {
                    static_cast<unsigned long long>(s.warnings),
                    pipeline.violated() ? "a property was violated" : "no property was violated");
     }
-    if (pipeline.violated()) return kViolated;
-    return s.rejected > 0 ? kBadInput : kOk;
+    return outcome.exit_code();
   }
 };
 
@@ -78,7 +69,8 @@ Runner register_check(CLI::App& app) {
   sub->add_option("--output,-o", cmd->output, "Where verdicts go: PATH, file:PATH or - (stdout)")->capture_default_str();
   sub->add_flag("--summary", cmd->summary, "Print message counts to stderr at the end");
   sub->footer(
-      "Exit status: 0 all properties held, 1 a property was violated, 2 usage or spec error, 3 messages were rejected.\n"
+      "Exit status: 0 all properties held, 1 a property was violated, 2 usage or spec error, 3 messages were\n"
+      "rejected, 5 runtime failure (the trace could not be read, verdicts could not be written).\n"
       "Example: rvc check --spec 'historically({emergency} -> once[0:1]{hazard_lights})' trace.jsonl");
   return [cmd] { return cmd->run(); };
 }

@@ -11,9 +11,8 @@
 #include "cli/check_options.hpp"
 #include "cli/commands.hpp"
 #include "cli/signals.hpp"
-#include "io/verdict_writer.hpp"
-#include "transport/frame_queue.hpp"
-#include "transport/seq_counter.hpp"
+#include "runtime/check_stream.hpp"
+#include "runtime/monitor_loop.hpp"
 #include "transport/transport_options.hpp"
 
 namespace rvc::cli {
@@ -26,36 +25,29 @@ struct MonitorCommand {
   std::vector<std::string> outputs;
   std::string stats_output;
   bool exit_on_eos = false;
+  double idle_timeout = 0;
   double stats_interval = 0;
   size_t queue_capacity = 1 << 14;
   size_t wait_subscribers = 0;  // per network output, before subscribing to the input
   double wait_timeout = 10;
-  double first_at = 0;  // wall clock when the first message arrived
 
-  // Wall-clock seconds (shared by processes on one host): benchmarks compute
-  // "first publish to last verdict" from replay's started_at and our done_at.
-  static double wall_now() {
-    return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
-  }
-
-  std::string stats_json(const transport::SeqCounters& c, const Pipeline& p, uint64_t verdicts, bool eos) const {
-    char buf[640];
-    std::snprintf(buf, sizeof buf,
-                  "{\"input\":\"%s\",\"received\":%llu,\"checked\":%llu,\"rejected\":%llu,\"gaps\":%llu,"
-                  "\"duplicates\":%llu,\"last_seq\":%llu,\"verdicts\":%llu,\"violations\":%llu,\"eos\":%s,"
-                  "\"first_at\":%.6f,\"done_at\":%.6f}",
-                  input.c_str(), static_cast<unsigned long long>(c.received),
-                  static_cast<unsigned long long>(p.stats().accepted), static_cast<unsigned long long>(p.stats().rejected),
-                  static_cast<unsigned long long>(c.gaps), static_cast<unsigned long long>(c.duplicates),
-                  static_cast<unsigned long long>(c.last_seq), static_cast<unsigned long long>(verdicts),
-                  static_cast<unsigned long long>(p.checker().violations()), eos ? "true" : "false", first_at,
-                  wall_now());
-    return buf;
+  // A file written by an output while it is read as the input would feed
+  // the monitor its own verdicts.
+  bool refuse_own_input(const std::string& output) const {
+    if (transport::scheme_of(input) != "file" || transport::scheme_of(output) != "file") return false;
+    auto path = [](const std::string& uri) { return uri.rfind("file:", 0) == 0 ? uri.substr(5) : uri; };
+    if (path(input) == "-" || path(output) == "-" || !runtime::same_regular_file(path(input), path(output)))
+      return false;
+    std::fprintf(stderr, "rvc: output '%s' is the input being read: refusing to overwrite it\n", output.c_str());
+    return true;
   }
 
   int run() {
     auto properties = check.properties();
     if (outputs.empty()) outputs.push_back("-");
+    for (const auto& uri : outputs)
+      if (refuse_own_input(uri)) return kUsage;
+    if (!stats_output.empty() && refuse_own_input(stats_output)) return kUsage;
     std::vector<std::unique_ptr<transport::Sink>> sinks;
     for (const auto& uri : outputs) sinks.push_back(transport::open_sink(uri, transports));
     std::unique_ptr<transport::Sink> stats_sink;
@@ -70,83 +62,33 @@ struct MonitorCommand {
       if (!sinks[i]->wait_matched(wait_subscribers, std::chrono::milliseconds(static_cast<long>(wait_timeout * 1000)))) {
         std::fprintf(stderr, "rvc: no subscriber matched on %s within %.1f s (--wait-timeout)\n", outputs[i].c_str(),
                      wait_timeout);
-        return kUsage;
+        return kIncomplete;
       }
     }
 
-    uint64_t verdicts = 0;
-    std::string line;
-    const bool discrete = !check.dense;
-    PipelineOptions popts = check.pipeline_options();
+    runtime::VerdictOutputs verdicts(std::move(sinks), !check.dense);
+    runtime::PipelineOptions popts = check.pipeline_options();
     popts.position_name = "seq";
-    Pipeline pipeline(properties, popts, [&](const engine::Verdict& v) {
-      line.clear();
-      io::append_verdict(line, v.time, discrete, v.property, v.value);
-      line.pop_back();  // one message per verdict, no newline
-      ++verdicts;
-      for (auto& s : sinks) s->put(line, verdicts);
-    });
+    runtime::Pipeline pipeline(properties, popts, [&](const engine::Verdict& v) { verdicts.put(v); });
 
-    transport::FrameQueue queue(queue_capacity);
+    runtime::LoopOptions lopts;
+    lopts.input = input;
+    // A file has nothing more to come after its end.
+    const bool from_file = transport::scheme_of(input) == "file";
+    lopts.exit_on_eos = exit_on_eos || from_file;
+    lopts.sequence_numbers = !from_file;
+    lopts.idle_timeout = idle_timeout;
+    lopts.stats_interval = stats_interval;
+    lopts.queue_capacity = queue_capacity;
+    lopts.stop_requested = stop_requested;
+    lopts.stats_requested = stats_requested;
+    runtime::MonitorLoop loop(pipeline, verdicts, stats_sink.get(), lopts);
+
     auto source = transport::open_source(input, transports);
     install_stop_signals();
-    source->start([&](const transport::Frame& f) { queue.push(f); });
     std::fprintf(stderr, "rvc monitor: %zu propert%s on %s -> %zu output%s\n", properties.size(),
-                 properties.size() == 1 ? "y" : "ies", input.c_str(), sinks.size(), sinks.size() == 1 ? "" : "s");
-
-    transport::SeqCounters counters;
-    std::vector<transport::OwnedFrame> batch;
-    size_t count = 0;
-    bool eos = false;
-    auto last_stats = std::chrono::steady_clock::now();
-    auto publish_stats = [&]() {
-      std::string js = stats_json(counters, pipeline, verdicts, eos);
-      std::fprintf(stderr, "%s\n", js.c_str());
-      if (stats_sink) stats_sink->put(js, 0);
-    };
-    while (!stop_requested() && !(eos && exit_on_eos)) {
-      if (!queue.pop_batch(batch, count, 100)) break;
-      if (count == 0) {
-        for (auto& s : sinks) s->idle();
-        continue;
-      }
-      if (count > 0 && first_at == 0) first_at = wall_now();
-      for (size_t i = 0; i < count; ++i) {
-        const transport::OwnedFrame& f = batch[i];
-        if (f.eos) {
-          counters.on_eos(f.seq);
-          eos = true;
-          continue;
-        }
-        counters.on_seq(f.seq);
-        pipeline.feed(f.payload, f.seq ? f.seq : counters.received);
-      }
-      if (stats_requested()) publish_stats();
-      if (stats_interval > 0 &&
-          std::chrono::steady_clock::now() - last_stats > std::chrono::duration<double>(stats_interval)) {
-        last_stats = std::chrono::steady_clock::now();
-        publish_stats();
-      }
-    }
-    for (auto& s : sinks) {
-      s->put_eos(verdicts);
-      s->flush();
-    }
-    counters.rejected = pipeline.stats().rejected;
-    std::string final_stats = stats_json(counters, pipeline, verdicts, eos);  // done_at: last verdict out
-    // Close the queue before stopping the source: stop() waits for a running
-    // transport callback, which may be blocked on a full queue.
-    queue.close();
-    source->stop();
-    pipeline.finish_report();
-    std::fprintf(stderr, "%s\n", final_stats.c_str());
-    if (stats_sink) {
-      stats_sink->put(final_stats, 0);
-      stats_sink->flush();
-    }
-    if (pipeline.violated()) return kViolated;
-    if (counters.gaps > 0 || counters.duplicates > 0) return kLost;
-    return pipeline.stats().rejected > 0 ? kBadInput : kOk;
+                 properties.size() == 1 ? "y" : "ies", input.c_str(), verdicts.size(), verdicts.size() == 1 ? "" : "s");
+    return loop.run(*source).exit_code();
   }
 };
 
@@ -160,7 +102,11 @@ Runner register_monitor(CLI::App& app) {
       ->required();
   sub->add_option("--output,-o", cmd->outputs, "Where verdicts go (repeatable): zenoh:KEY, dds:TOPIC, file:PATH, - (default)")
       ->allow_extra_args(false);
-  sub->add_flag("--exit-on-eos", cmd->exit_on_eos, "Exit after the publisher's end-of-stream marker");
+  sub->add_flag("--exit-on-eos", cmd->exit_on_eos,
+                "Exit after the publisher's end-of-stream marker (ending any other way is then exit 6)");
+  sub->add_option("--idle-timeout", cmd->idle_timeout,
+                  "Give up after S seconds without any message (0: wait forever); with --exit-on-eos that is exit 6")
+      ->check(CLI::NonNegativeNumber);
   sub->add_option("--stats-interval", cmd->stats_interval, "Print counters every S seconds (also on SIGUSR1)");
   sub->add_option("--stats-output", cmd->stats_output, "Also publish the counters (JSON) to this endpoint");
   sub->add_option("--wait-subscribers", cmd->wait_subscribers,
@@ -170,7 +116,9 @@ Runner register_monitor(CLI::App& app) {
   sub->add_option("--queue", cmd->queue_capacity, "Messages buffered between transport and engine")->capture_default_str();
   transport::add_transport_options(*sub, cmd->transports);
   sub->footer(
-      "Exit status: 0 all held, 1 a property was violated, 2 usage/spec error, 3 messages rejected, 4 messages lost.\n"
+      "Exit status: 0 all held, 1 a property was violated, 2 usage/spec error, 3 messages rejected, 4 messages lost,\n"
+      "5 runtime failure (an output could not be written), 6 incomplete (nothing received, or no end-of-stream\n"
+      "marker with --exit-on-eos).\n"
       "Example: rvc monitor --spec 'historically({emergency} -> once[0:1]{hazard_lights})' \\\n"
       "           --input zenoh:vehicle/status --output zenoh:rv/verdicts");
   return [cmd] { return cmd->run(); };

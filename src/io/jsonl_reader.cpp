@@ -288,6 +288,7 @@ bool read_jsonl(int fd, JsonlHandler& handler, const ReaderOptions& options, std
     }
     if (complete > 0) {
       processor.process(buf.data(), complete, line);
+      if (options.after_chunk) options.after_chunk();
       line += static_cast<uint64_t>(count_newlines(buf.data(), buf.data() + complete));
       std::memmove(buf.data(), buf.data() + complete, have - complete);
       have -= complete;

@@ -14,6 +14,7 @@
 #include <simdjson.h>
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -70,6 +71,7 @@ class JsonlHandler {
 struct ReaderOptions {
   size_t chunk_bytes = 1 << 20;
   size_t max_line_bytes = 1 << 20;  // longer lines are rejected as oversized
+  std::function<void()> after_chunk;  // called after each chunk of lines is handled (may be empty)
 };
 
 // Reads fd to its end. Returns false (with `error`) only on I/O failure.

@@ -8,11 +8,11 @@
 #include <string>
 #include <vector>
 
-#include "cli/pipeline.hpp"
+#include "runtime/pipeline.hpp"
 #include "spec/spec_error.hpp"
 #include "test_util.hpp"
 
-namespace rvc::cli {
+namespace rvc::runtime {
 namespace {
 
 using test::TV;
@@ -239,4 +239,4 @@ TEST(Pipeline, DenseBoundedOperatorOverAFile) {
 }
 
 }  // namespace
-}  // namespace rvc::cli
+}  // namespace rvc::runtime

@@ -1,11 +1,14 @@
 // decode -> engine -> verdicts, shared by `rvc check` (files) and
 // `rvc monitor` (network): one JSON decode per message for all properties,
-// time-order checks for dense time, and counters for what was rejected.
+// time-order checks for dense time, size limits, and counters for what was
+// rejected. A file read line by line and the same lines arriving as network
+// payloads go through the same rules, so check and monitor agree.
 #pragma once
 
 #include <simdjson.h>
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -13,7 +16,7 @@
 #include "io/json_decoder.hpp"
 #include "io/jsonl_reader.hpp"
 
-namespace rvc::cli {
+namespace rvc::runtime {
 
 struct PipelineOptions {
   engine::TimeModel model = engine::TimeModel::Discrete;
@@ -23,7 +26,7 @@ struct PipelineOptions {
   std::string position_name = "line";  // how errors name a message: "line 12", "seq 12"
   size_t max_reported = 100;           // errors and warnings printed before going quiet
   bool parse_only = false;             // decode every message but run no monitor (benchmark floor)
-  size_t max_message_size = 1 << 20;   // longest line inside a batched payload
+  size_t max_message_size = 1 << 20;   // longest message: a line, a payload, a line inside a batched payload
 };
 
 struct PipelineStats {
@@ -44,7 +47,8 @@ class Pipeline final : public io::JsonlHandler {
   void discard() override { pending_ = false; }
   void on_error(const io::LineError& error) override;
   // One network payload; `position` names it in errors (its sequence number).
-  // A payload holding several lines is a batch: one message per line.
+  // A payload holding several lines is a batch: one message per line. A
+  // payload (or line) over max_message_size is rejected, as in a file.
   void feed(std::string_view payload, uint64_t position);
 
   const PipelineStats& stats() const { return stats_; }
@@ -61,7 +65,9 @@ class Pipeline final : public io::JsonlHandler {
   PipelineStats stats_;
   bool has_time_ = false;
   bool pending_ = false;        // decoded, waiting for commit()
-  const io::Position* pending_where_ = nullptr;
+  // Where the pending message came from. A copy, not a pointer: the reader's
+  // Position may be a temporary that is gone by commit().
+  std::optional<io::Position> pending_where_;
   double last_time_ = 0;
   uint64_t reported_ = 0;
   std::vector<std::string> warnings_;
@@ -72,4 +78,4 @@ class Pipeline final : public io::JsonlHandler {
   uint64_t batch_position_ = 0;  // position of the payload being read as a batch, else 0
 };
 
-}  // namespace rvc::cli
+}  // namespace rvc::runtime

@@ -1,11 +1,11 @@
-#include "cli/pipeline.hpp"
+#include "runtime/pipeline.hpp"
 
 #include <cstdio>
 
 #include "io/verdict_writer.hpp"
 #include "spec/spec_error.hpp"
 
-namespace rvc::cli {
+namespace rvc::runtime {
 namespace {
 
 engine::Checker build(const std::vector<engine::PropertySpec>& properties, const PipelineOptions& options,
@@ -66,7 +66,7 @@ io::ReadResult Pipeline::on_object(const io::Position& where, simdjson::ondemand
     report("warning: " + options_.position_name + " " + std::to_string(where.number()) + ": " + w);
   }
   pending_ = true;
-  pending_where_ = &where;  // valid until the reader calls commit() (same stack frame)
+  pending_where_.emplace(where);
   return io::ReadResult::Pending;
 }
 
@@ -99,9 +99,17 @@ void Pipeline::commit() {
 
 void Pipeline::feed(std::string_view payload, uint64_t position) {
   if (payload.find('\n') != std::string_view::npos) {
+    // A batch: the reader applies the size limit to each line.
     batch_position_ = position;
     batch_reader_.read(payload, 1);
     batch_position_ = 0;
+    return;
+  }
+  if (payload.size() > options_.max_message_size) {
+    // Worded as the file reader words it: check and monitor report alike.
+    on_error(io::LineError{position, 0,
+                           "message longer than " + std::to_string(options_.max_message_size) +
+                               " bytes (--max-message-size); skipped"});
     return;
   }
   io::parse_one(parser_, payload, position, *this, scratch_);
@@ -113,4 +121,4 @@ void Pipeline::finish_report() {
                  static_cast<unsigned long long>(reported_ - options_.max_reported));
 }
 
-}  // namespace rvc::cli
+}  // namespace rvc::runtime

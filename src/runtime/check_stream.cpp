@@ -1,0 +1,36 @@
+#include "runtime/check_stream.hpp"
+
+#include <sys/stat.h>
+
+#include <cstdio>
+#include <exception>
+
+namespace rvc::runtime {
+
+Outcome check_stream(int fd, Pipeline& pipeline, VerdictOutputs& outputs, io::ReaderOptions reader, bool live) {
+  Outcome outcome;
+  if (live) reader.after_chunk = [&outputs] { outputs.idle(); };
+  try {
+    std::string error;
+    if (!io::read_jsonl(fd, pipeline, reader, error)) {
+      std::fprintf(stderr, "rvc: error: %s\n", error.c_str());
+      outcome.runtime_failure = true;
+    }
+    outputs.finish();
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "rvc: error: %s\n", e.what());
+    outcome.runtime_failure = true;
+  }
+  pipeline.finish_report();
+  outcome.violated = pipeline.violated();
+  outcome.rejected = pipeline.stats().rejected > 0;
+  return outcome;
+}
+
+bool same_regular_file(const std::string& a, const std::string& b) {
+  struct stat sa, sb;
+  if (::stat(a.c_str(), &sa) != 0 || ::stat(b.c_str(), &sb) != 0) return false;
+  return S_ISREG(sa.st_mode) && sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+}
+
+}  // namespace rvc::runtime

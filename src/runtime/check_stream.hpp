@@ -1,0 +1,22 @@
+// `rvc check`'s run: a JSON-lines stream (a file or stdin) read in chunks
+// through the same Pipeline and VerdictOutputs as `rvc monitor`.
+#pragma once
+
+#include "io/jsonl_reader.hpp"
+#include "runtime/exit_status.hpp"
+#include "runtime/pipeline.hpp"
+#include "runtime/verdict_outputs.hpp"
+
+namespace rvc::runtime {
+
+// Reads `fd` to its end. Never throws for a failure while running (a read
+// error, an output that cannot be written): the outcome says so and the
+// reason is printed. `live`: flush verdicts after every chunk read (stdin fed
+// by another program, where verdicts should show as soon as they are known).
+Outcome check_stream(int fd, Pipeline& pipeline, VerdictOutputs& outputs, io::ReaderOptions reader, bool live);
+
+// True if both paths name the same existing regular file (also through links):
+// used to refuse writing verdicts over the input being read.
+bool same_regular_file(const std::string& a, const std::string& b);
+
+}  // namespace rvc::runtime

@@ -1,0 +1,26 @@
+#include "runtime/verdict_outputs.hpp"
+
+#include "io/verdict_writer.hpp"
+
+namespace rvc::runtime {
+
+void VerdictOutputs::put(const engine::Verdict& v) {
+  line_.clear();
+  io::append_verdict(line_, v.time, discrete_, v.property, v.value);
+  line_.pop_back();  // one message per verdict: no newline (file sinks add their own)
+  ++count_;
+  for (auto& s : sinks_) s->put(line_, count_);
+}
+
+void VerdictOutputs::idle() {
+  for (auto& s : sinks_) s->idle();
+}
+
+void VerdictOutputs::finish() {
+  for (auto& s : sinks_) {
+    s->put_eos(count_);
+    s->flush();
+  }
+}
+
+}  // namespace rvc::runtime

@@ -1,0 +1,41 @@
+// Verdicts -> every output endpoint, as JSON lines ({"time":..,"property":..,
+// "value":..}), one payload per verdict. `rvc check` writes to one file sink,
+// `rvc monitor` to any number of file/zenoh/dds sinks: the same code, so both
+// format and account for verdicts alike.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "engine/checker.hpp"
+#include "transport/endpoint.hpp"
+
+namespace rvc::runtime {
+
+class VerdictOutputs {
+ public:
+  VerdictOutputs(std::vector<std::unique_ptr<transport::Sink>> sinks, bool discrete)
+      : sinks_(std::move(sinks)), discrete_(discrete) {}
+
+  // Publishes one verdict on every sink. Throws (std::runtime_error) if a
+  // sink cannot take it: verdicts that cannot be delivered end the run.
+  void put(const engine::Verdict& verdict);
+  // Nothing pending upstream: make buffered verdicts visible.
+  void idle();
+  // The end-of-stream marker, then a flush, on every sink. Throws as put().
+  void finish();
+
+  uint64_t count() const { return count_; }
+  size_t size() const { return sinks_.size(); }
+  transport::Sink& sink(size_t i) { return *sinks_[i]; }
+
+ private:
+  std::vector<std::unique_ptr<transport::Sink>> sinks_;
+  bool discrete_;
+  uint64_t count_ = 0;
+  std::string line_;
+};
+
+}  // namespace rvc::runtime
