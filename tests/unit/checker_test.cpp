@@ -136,15 +136,11 @@ std::string balanced_or(int lo, int hi) {  // {aLO} or ... or {aHI-1}, as a bala
 }
 
 TEST(Checker, AtomIndexBeyond65535AcrossProperties) {
-  // BUG (src/engine/discrete/monitor.cpp): the discrete Monitor addresses
-  // atoms by their index in the Checker-wide AtomTable through uint16_t
-  // slots. The table is shared by all properties, so once the properties
-  // together use more than ~65,000 distinct atoms, later properties (here
-  // big4, 20k nodes, and even the one-node {z}) are refused with
-  // std::length_error "property too large (more than 65000 nodes)". (An
-  // earlier version of the same code silently read atom 70000 as atom 4464.)
-  // Fix: map each property's atoms to local slots (or use 32-bit slots), so
-  // the limit applies per property.
+  // Regression: the discrete Monitor once addressed atoms through uint16_t
+  // slots indexed by the Checker-wide AtomTable, so once all properties
+  // together used more than ~65,000 atoms, later ones were refused (and an
+  // earlier version read atom 70000 as atom 4464). Atom slots are per
+  // property now; the limit applies to each property alone.
   Recorder r;
   Checker c(TimeModel::Discrete, false, r.callback());
   for (int k = 0; k < 7; ++k) c.add_property({"big" + std::to_string(k), balanced_or(10000 * k, 10000 * (k + 1))});
