@@ -3,7 +3,7 @@
 
 namespace rvc::io {
 
-void append_verdict(std::string& out, double time, bool discrete, std::string_view property, bool value) {
+void append_verdict(std::string& out, double time, bool /*discrete: times print alike*/, std::string_view property, bool value) {
   out += "{\"time\":";
   append_number(out, time);
   out += ",\"property\":";

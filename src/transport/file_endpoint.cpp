@@ -1,37 +1,72 @@
 #include "transport/file_endpoint.hpp"
 
+#include <fcntl.h>
+#include <poll.h>
 #include <unistd.h>
 
+#include <cerrno>
+#include <cstring>
 #include <stdexcept>
+#include <string>
 
 namespace rvc::transport {
 
 FileSource::FileSource(std::string path) : path_(std::move(path)) {
-  file_ = path_ == "-" ? stdin : std::fopen(path_.c_str(), "r");
-  if (!file_) throw std::invalid_argument("cannot open '" + path_ + "' for reading");
+  fd_ = path_ == "-" ? 0 : ::open(path_.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd_ < 0) throw std::invalid_argument("cannot open '" + path_ + "' for reading: " + std::strerror(errno));
 }
 
 FileSource::~FileSource() {
   stop();
-  if (file_ && file_ != stdin) std::fclose(file_);
+  if (fd_ > 0) ::close(fd_);
 }
 
 void FileSource::start(FrameHandler handler) {
-  reader_ = std::thread([this, handler = std::move(handler)] {
-    char* line = nullptr;
-    size_t cap = 0;
-    uint64_t seq = 0;
-    ssize_t n;
-    while (!stop_ && (n = ::getline(&line, &cap, file_)) >= 0) {
-      size_t len = static_cast<size_t>(n);
-      while (len > 0 && (line[len - 1] == '\n' || line[len - 1] == '\r')) --len;
-      ++seq;
-      if (len == 0) continue;  // blank lines are not messages
-      handler(Frame{std::string_view(line, len), seq, false});
+  reader_ = std::thread([this, handler = std::move(handler)] { read_all(handler); });
+}
+
+void FileSource::read_all(const FrameHandler& handler) {
+  std::string buf;       // bytes read, not yet split into lines
+  size_t scanned = 0;    // buf[0, scanned) holds no newline
+  uint64_t line = 0;
+  bool first = true;
+  auto deliver = [&](size_t begin, size_t end) {
+    size_t len = end - begin;
+    while (len > 0 && buf[begin + len - 1] == '\r') --len;
+    ++line;
+    // A UTF-8 byte-order mark at the start of the file is not part of the
+    // message (`rvc check` skips it too).
+    if (first && len >= 3 && std::memcmp(buf.data() + begin, "\xEF\xBB\xBF", 3) == 0) begin += 3, len -= 3;
+    first = false;
+    if (len > 0) handler(Frame{std::string_view(buf.data() + begin, len), line, false});  // blank lines: no message
+  };
+  char chunk[1 << 16];
+  for (;;) {
+    if (stop_.load(std::memory_order_relaxed)) return;
+    pollfd p{fd_, POLLIN, 0};
+    int ready = ::poll(&p, 1, 100);  // wake up now and then to see stop()
+    if (ready < 0 && errno != EINTR) break;
+    if (ready <= 0) continue;
+    ssize_t n = ::read(fd_, chunk, sizeof chunk);
+    if (n < 0) {
+      if (errno == EINTR || errno == EAGAIN) continue;
+      break;  // a read error ends the input like its end would
     }
-    std::free(line);
-    if (!stop_) handler(Frame{{}, seq, true});
-  });
+    if (n == 0) break;
+    buf.append(chunk, static_cast<size_t>(n));
+    size_t begin = 0;
+    for (;;) {
+      const void* nl = std::memchr(buf.data() + scanned, '\n', buf.size() - scanned);
+      if (!nl) break;
+      size_t end = static_cast<size_t>(static_cast<const char*>(nl) - buf.data());
+      deliver(begin, end);
+      begin = scanned = end + 1;
+    }
+    buf.erase(0, begin);
+    scanned = buf.size();
+  }
+  if (!buf.empty()) deliver(0, buf.size());  // a last line without its newline
+  if (!stop_.load()) handler(Frame{{}, line, true});
 }
 
 void FileSource::stop() {
@@ -39,32 +74,37 @@ void FileSource::stop() {
   if (reader_.joinable()) reader_.join();
 }
 
-FileSink::FileSink(std::string path) {
-  if (path == "-") {
+FileSink::FileSink(std::string path) : path_(std::move(path)) {
+  if (path_ == "-") {
     file_ = stdout;
     line_buffered_ = isatty(1);
   } else {
-    file_ = std::fopen(path.c_str(), "w");
+    file_ = std::fopen(path_.c_str(), "w");
     owned_ = true;
   }
-  if (!file_) throw std::invalid_argument("cannot open '" + path + "' for writing");
+  if (!file_) throw std::invalid_argument("cannot open '" + path_ + "' for writing: " + std::strerror(errno));
 }
 
 FileSink::~FileSink() {
-  flush();
+  std::fflush(file_);  // errors were reported by flush(), which the owners call at the end
   if (owned_) std::fclose(file_);
 }
 
+void FileSink::fail(int error) const {
+  throw std::runtime_error("cannot write '" + (path_ == "-" ? std::string("stdout") : path_) +
+                           "': " + std::strerror(error));
+}
+
 void FileSink::put(std::string_view payload, uint64_t) {
-  std::fwrite(payload.data(), 1, payload.size(), file_);
-  std::fputc('\n', file_);
-  if (line_buffered_) std::fflush(file_);
+  if (std::fwrite(payload.data(), 1, payload.size(), file_) != payload.size() || std::fputc('\n', file_) == EOF)
+    fail(errno);
+  if (line_buffered_) flush();
   else dirty_ = true;
 }
 
 void FileSink::flush() {
-  std::fflush(file_);
   dirty_ = false;
+  if (std::fflush(file_) != 0 || std::ferror(file_)) fail(errno ? errno : EIO);
 }
 
 }  // namespace rvc::transport

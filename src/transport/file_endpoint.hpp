@@ -1,8 +1,9 @@
-// file:PATH endpoints: JSON lines. As a source, each line is one frame (seq =
-// line number) followed by an end-of-stream frame; as a sink, each payload is
-// written as one line.
+// file:PATH endpoints: JSON lines. As a source, each non-blank line is one
+// frame (seq = line number) followed by an end-of-stream frame at the end of
+// the file; as a sink, each payload is written as one line.
 #pragma once
 
+#include <atomic>
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -17,19 +18,25 @@ class FileSource final : public Source {
   explicit FileSource(std::string path);  // "-" is stdin; throws if unreadable
   ~FileSource() override;
   void start(FrameHandler handler) override;
+  // Returns promptly even while the reader waits for input that never comes
+  // (stdin, a pipe): the reader polls and checks the flag between waits.
   void stop() override;
 
  private:
+  void read_all(const FrameHandler& handler);
+
   std::string path_;
-  std::FILE* file_ = nullptr;
+  int fd_ = -1;
   std::thread reader_;
-  bool stop_ = false;
+  std::atomic<bool> stop_{false};
 };
 
 class FileSink final : public Sink {
  public:
   explicit FileSink(std::string path);  // "-" is stdout; throws if unwritable
-  ~FileSink() override;
+  ~FileSink() override;                 // best-effort flush; never throws
+  // put/flush throw std::runtime_error naming the file when a write fails
+  // (a full disk, a closed pipe): verdicts are never dropped silently.
   void put(std::string_view payload, uint64_t seq) override;
   void put_eos(uint64_t last_seq) override { flush(); }
   void flush() override;
@@ -38,6 +45,9 @@ class FileSink final : public Sink {
   }
 
  private:
+  [[noreturn]] void fail(int error) const;
+
+  std::string path_;
   std::FILE* file_ = nullptr;
   bool dirty_ = false;
   bool owned_ = false;

@@ -43,21 +43,6 @@ TEST(VerdictWriter, VerdictLine) {
             "{\"time\":2.5,\"property\":\"speed \\\"limit\\\"\",\"value\":true}\n");
 }
 
-TEST(VerdictWriter, WritesToAFile) {
-  char* data = nullptr;
-  size_t size = 0;
-  std::FILE* f = open_memstream(&data, &size);
-  {
-    VerdictWriter w(f, true, false);
-    w.write(0, "a", true);
-    w.write(3, "b", false);
-  }  // flushed on destruction
-  std::fclose(f);
-  EXPECT_EQ(std::string(data, size),
-            "{\"time\":0,\"property\":\"a\",\"value\":true}\n{\"time\":3,\"property\":\"b\",\"value\":false}\n");
-  std::free(data);
-}
-
 // ---------------------------------------------------------------- properties
 
 TEST(PropertiesFile, ListOfNamedSpecs) {
