@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "cli/commands.hpp"
+#include "io/json_writer.hpp"
 #include "cli/signals.hpp"
 #include "transport/transport_options.hpp"
 
@@ -29,16 +30,6 @@ struct Route {
   std::atomic<uint64_t> forwarded{0};
   std::atomic<uint64_t> eos_count{0};
 };
-
-std::string json_escape(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    if (c == '"' || c == '\\') out += '\\';
-    if (static_cast<unsigned char>(c) < 0x20) continue;
-    out += c;
-  }
-  return out;
-}
 
 struct BridgeCommand {
   transport::TransportOptions transports;
@@ -119,15 +110,14 @@ struct BridgeCommand {
     }
     for (auto& r : routes) r->source->stop();
     for (auto& r : routes) r->sink->flush();
-    std::string js = "{\"routes\":[";
-    for (size_t i = 0; i < routes.size(); ++i) {
-      const Route& r = *routes[i];
-      js += (i ? "," : "");
-      js += "{\"from\":\"" + json_escape(r.from) + "\",\"to\":\"" + json_escape(r.to) +
-            "\",\"forwarded\":" + std::to_string(r.forwarded.load()) + ",\"eos\":" + std::to_string(r.eos_count.load()) +
-            "}";
-    }
-    js += "]}";
+    io::JsonArray summary;
+    for (const auto& r : routes)
+      summary.add(io::JsonObject()
+                      .add("from", r->from)
+                      .add("to", r->to)
+                      .add("forwarded", r->forwarded.load())
+                      .add("eos", r->eos_count.load()));
+    std::string js = io::JsonObject().add_raw("routes", summary.str()).str();
     std::printf("%s\n", js.c_str());
     return kOk;
   }

@@ -8,6 +8,7 @@
 #include <atomic>
 #include <chrono>
 #include <mutex>
+#include <optional>
 #include <vector>
 #include <cstdio>
 #include <memory>
@@ -16,6 +17,7 @@
 
 #include "cli/commands.hpp"
 #include "cli/signals.hpp"
+#include "io/json_writer.hpp"
 #include "transport/transport_options.hpp"
 
 namespace rvc::cli {
@@ -88,7 +90,7 @@ struct ReplayCommand {
       if (!sink->wait_matched(wait_subscribers, std::chrono::milliseconds(static_cast<long>(wait_timeout * 1000)))) {
         std::fprintf(stderr, "rvc: no subscriber matched on %s within %.1f s (--wait-timeout; --wait-subscribers 0 to not wait)\n",
                      to.c_str(), wait_timeout);
-        return kUsage;
+        return kIncomplete;
       }
     }
     const bool show = progress && isatty(2);
@@ -111,14 +113,26 @@ struct ReplayCommand {
       }
       sink->put(payload, samples);
     };
-    while (!stop_requested() && (n = ::getline(&line, &cap, in)) >= 0) {
+    bool interrupted = false;
+    while (!(interrupted = stop_requested()) && (n = ::getline(&line, &cap, in)) >= 0) {
       bytes += n;
       size_t len = static_cast<size_t>(n);
       while (len > 0 && (line[len - 1] == '\n' || line[len - 1] == '\r')) --len;
       if (len == 0) continue;
+      seq = events + 1;  // this message's number: counted as sent once it is sent
+      // Wait for this message's slot in short steps, so that a stop signal
+      // during the wait is seen before the message is sent.
+      if (hz > 0) {
+        const auto due = t0 + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                  std::chrono::duration<double>(static_cast<double>(seq - 1) / hz));
+        while (!stop_requested() && std::chrono::steady_clock::now() < due)
+          std::this_thread::sleep_until(std::min(due, std::chrono::steady_clock::now() + std::chrono::milliseconds(20)));
+        if (stop_requested()) {
+          interrupted = true;
+          break;
+        }
+      }
       ++events;
-      seq = events;
-      if (hz > 0) std::this_thread::sleep_until(t0 + std::chrono::duration<double>(static_cast<double>(seq - 1) / hz));
       if (batch <= 1) {
         send(std::string_view(line, len));
       } else {
@@ -154,7 +168,8 @@ struct ReplayCommand {
     std::fprintf(stderr, "rvc replay: sent %llu messages in %llu samples in %.3f s (%.0f msg/s) to %s\n",
                  static_cast<unsigned long long>(events), static_cast<unsigned long long>(samples), s,
                  s > 0 ? events / s : 0.0, to.c_str());
-    std::string latency;
+    std::optional<io::JsonObject> latency;
+    size_t verdicts_back_n = 0;
     if (echo) {
       auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
       while (verdicts_back < seq && std::chrono::steady_clock::now() < deadline)
@@ -165,15 +180,30 @@ struct ReplayCommand {
       auto pct = [&](double q) {
         return latency_us.empty() ? 0.0 : latency_us[std::min(latency_us.size() - 1, static_cast<size_t>(q * latency_us.size()))];
       };
-      char buf[256];
-      std::snprintf(buf, sizeof buf,
-                    ",\"verdicts_back\":%zu,\"latency_us\":{\"p50\":%.1f,\"p90\":%.1f,\"p99\":%.1f,\"max\":%.1f}",
-                    latency_us.size(), pct(0.5), pct(0.9), pct(0.99), latency_us.empty() ? 0.0 : latency_us.back());
-      latency = buf;
+      latency = io::JsonObject()
+                    .add("p50", pct(0.5))
+                    .add("p90", pct(0.9))
+                    .add("p99", pct(0.99))
+                    .add("max", latency_us.empty() ? 0.0 : latency_us.back());
+      verdicts_back_n = latency_us.size();
     }
-    std::printf("{\"sent\":%llu,\"samples\":%llu,\"seconds\":%.6f,\"msgs_per_s\":%.1f,\"started_at\":%.6f%s}\n",
-                static_cast<unsigned long long>(events), static_cast<unsigned long long>(samples), s,
-                s > 0 ? events / s : 0.0, started_at, latency.c_str());
+    io::JsonObject summary;
+    summary.add("sent", events)
+        .add("samples", samples)
+        .add_fixed("seconds", s, 6)
+        .add_fixed("msgs_per_s", s > 0 ? events / s : 0.0, 1)
+        .add_fixed("started_at", started_at, 6);
+    if (latency) summary.add("verdicts_back", verdicts_back_n).add("latency_us", *latency);
+    // The summary must not mix with the data when the data goes to stdout.
+    std::FILE* out = transport::scheme_of(to) == "file" && (to == "-" || to == "file:-" || to == "file:/dev/stdout")
+                         ? stderr
+                         : stdout;
+    std::fprintf(out, "%s\n", summary.str().c_str());
+    if (interrupted) {
+      std::fprintf(stderr, "rvc replay: stopped by a signal after %llu of the input's messages: incomplete\n",
+                   static_cast<unsigned long long>(events));
+      return kIncomplete;
+    }
     return kOk;
   }
 };

@@ -14,6 +14,7 @@
 #include <string_view>
 #include <thread>
 
+#include "io/json_writer.hpp"
 #include "transport/seq_counter.hpp"
 #ifdef RVC_HAVE_ZENOH
 #include "transport/zenoh/rvc_zenoh.h"
@@ -44,11 +45,10 @@ enum Exit : int { kOk = 0, kNoPeer = 2, kLost = 4 };
 
 bool stop_now(const PerfOptions& o) { return o.should_stop && o.should_stop(); }
 
-std::string rate_json(double hz) {
-  if (hz <= 0) return "\"max\"";
-  char b[32];
-  std::snprintf(b, sizeof b, "%g", hz);
-  return b;
+// The rate as the summaries show it: messages/s, or "max".
+void add_rate(io::JsonObject& js, double hz) {
+  if (hz <= 0) js.add("rate", "max");
+  else js.add("rate", hz);
 }
 
 // ---------------------------------------------------------------- transport
@@ -279,16 +279,22 @@ std::string sub_json(const PerfOptions& o, const char* role, SubCounter& s, uint
   const double mps = steady ? steady_n / steady_span : avg;
   const double avg_size = received ? static_cast<double>(s.bytes.load()) / received : static_cast<double>(o.size);
   const double mbps = mps * avg_size * 8 / 1e6;
-  char buf[640];
-  std::snprintf(buf, sizeof buf,
-                "{\"role\":\"%s\",\"transport\":\"%s\",\"size\":%.0f,\"msgs_per_s\":%.1f,\"mbps\":%.3f,"
-                "\"lost\":%llu,\"sent\":%llu,\"received\":%llu,\"duplicates\":%llu,\"seconds\":%.6f,"
-                "\"avg_msgs_per_s\":%.1f,\"steady_seconds\":%.6f,\"reliable\":%s,\"eos\":%s}",
-                role, o.transport.c_str(), avg_size, mps, mbps, static_cast<unsigned long long>(s.c.gaps),
-                static_cast<unsigned long long>(sent), static_cast<unsigned long long>(received),
-                static_cast<unsigned long long>(s.c.duplicates), span, avg, steady ? steady_span : span,
-                o.best_effort ? "false" : "true", eos ? "true" : "false");
-  return buf;
+  return io::JsonObject()
+      .add("role", role)
+      .add("transport", o.transport)
+      .add_fixed("size", avg_size, 0)
+      .add_fixed("msgs_per_s", mps, 1)
+      .add_fixed("mbps", mbps, 3)
+      .add("lost", s.c.gaps)
+      .add("sent", sent)
+      .add("received", received)
+      .add("duplicates", s.c.duplicates)
+      .add_fixed("seconds", span, 6)
+      .add_fixed("avg_msgs_per_s", avg, 1)
+      .add_fixed("steady_seconds", steady ? steady_span : span, 6)
+      .add("reliable", !o.best_effort)
+      .add("eos", eos)
+      .str();
 }
 
 // Publishes for --duration at --rate (or as fast as the reliable transport
@@ -574,10 +580,17 @@ int run_pub(const PerfOptions& o) {
     return (!o.best_effort && s.c.gaps > 0) ? kLost : kOk;
   }
   const double mps = r.seconds > 0 ? r.sent / r.seconds : 0;
-  std::printf("{\"role\":\"pub\",\"transport\":\"%s\",\"size\":%zu,\"rate\":%s,\"msgs_per_s\":%.1f,\"mbps\":%.3f,"
-              "\"lost\":null,\"sent\":%llu,\"received\":null,\"seconds\":%.6f,\"reliable\":%s}\n",
-              o.transport.c_str(), o.size, rate_json(o.rate).c_str(), mps, mps * o.size * 8 / 1e6,
-              static_cast<unsigned long long>(r.sent), r.seconds, o.best_effort ? "false" : "true");
+  io::JsonObject js;
+  js.add("role", "pub").add("transport", o.transport).add("size", o.size);
+  add_rate(js, o.rate);
+  js.add_fixed("msgs_per_s", mps, 1)
+      .add_fixed("mbps", mps * o.size * 8 / 1e6, 3)
+      .add_raw("lost", "null")  // a publisher cannot know: see the subscriber's line
+      .add("sent", r.sent)
+      .add_raw("received", "null")
+      .add_fixed("seconds", r.seconds, 6)
+      .add("reliable", !o.best_effort);
+  std::printf("%s\n", js.str().c_str());
   std::fflush(stdout);
   return kOk;
 }
@@ -605,9 +618,13 @@ int run_pong(const PerfOptions& o) {
   src->stop();
   sink->flush();
   const uint64_t n = s.c.received;
-  std::printf("{\"role\":\"pong\",\"transport\":\"%s\",\"size\":%.0f,\"echoed\":%llu}\n", o.transport.c_str(),
-              n ? static_cast<double>(s.bytes.load()) / n : static_cast<double>(o.size),
-              static_cast<unsigned long long>(n));
+  std::printf("%s\n", io::JsonObject()
+                          .add("role", "pong")
+                          .add("transport", o.transport)
+                          .add_fixed("size", n ? static_cast<double>(s.bytes.load()) / n : static_cast<double>(o.size), 0)
+                          .add("echoed", n)
+                          .str()
+                          .c_str());
   std::fflush(stdout);
   return got ? kOk : kNoPeer;
 }
@@ -651,12 +668,20 @@ int run_ping(const PerfOptions& o) {
   if (pong_src) pong_src->stop();
   const uint64_t back = p.pongs.load();
   LatencyStats st = latency_stats(p.rtts);
-  std::printf("{\"role\":\"ping\",\"transport\":\"%s\",\"size\":%zu,\"rate\":%s,\"count\":%zu,\"sent\":%llu,"
-              "\"lost\":%llu,\"mean_us\":%.3f,\"min_us\":%.3f,\"p50_us\":%.3f,\"p90_us\":%.3f,\"p99_us\":%.3f,"
-              "\"max_us\":%.3f,\"reliable\":%s}\n",
-              o.transport.c_str(), o.size, rate_json(o.rate).c_str(), st.count, static_cast<unsigned long long>(sent),
-              static_cast<unsigned long long>(sent > back ? sent - back : 0), st.mean_us, st.min_us, st.p50_us,
-              st.p90_us, st.p99_us, st.max_us, o.best_effort ? "false" : "true");
+  io::JsonObject js;
+  js.add("role", "ping").add("transport", o.transport).add("size", o.size);
+  add_rate(js, o.rate);
+  js.add("count", st.count)
+      .add("sent", sent)
+      .add("lost", sent > back ? sent - back : 0)
+      .add_fixed("mean_us", st.mean_us, 3)
+      .add_fixed("min_us", st.min_us, 3)
+      .add_fixed("p50_us", st.p50_us, 3)
+      .add_fixed("p90_us", st.p90_us, 3)
+      .add_fixed("p99_us", st.p99_us, 3)
+      .add_fixed("max_us", st.max_us, 3)
+      .add("reliable", !o.best_effort);
+  std::printf("%s\n", js.str().c_str());
   std::fflush(stdout);
   if (back == 0) return kNoPeer;
   return kOk;
