@@ -67,7 +67,9 @@ struct BridgeCommand {
                                    std::chrono::milliseconds(static_cast<long>(wait_timeout * 1000)))) {
           std::fprintf(stderr, "rvc bridge: no subscriber matched on %s within %.1f s (--wait-timeout)\n",
                        r->to.c_str(), wait_timeout);
-          return kUsage;
+          if (!r->sink->discovery().empty())
+            std::fprintf(stderr, "rvc: this publisher: %s\n", r->sink->discovery().c_str());
+          return kIncomplete;
         }
       }
     }

@@ -62,6 +62,8 @@ struct MonitorCommand {
       if (!sinks[i]->wait_matched(wait_subscribers, std::chrono::milliseconds(static_cast<long>(wait_timeout * 1000)))) {
         std::fprintf(stderr, "rvc: no subscriber matched on %s within %.1f s (--wait-timeout)\n", outputs[i].c_str(),
                      wait_timeout);
+        if (!sinks[i]->discovery().empty())
+          std::fprintf(stderr, "rvc: this publisher: %s\n", sinks[i]->discovery().c_str());
         return kIncomplete;
       }
     }

@@ -90,6 +90,7 @@ struct ReplayCommand {
       if (!sink->wait_matched(wait_subscribers, std::chrono::milliseconds(static_cast<long>(wait_timeout * 1000)))) {
         std::fprintf(stderr, "rvc: no subscriber matched on %s within %.1f s (--wait-timeout; --wait-subscribers 0 to not wait)\n",
                      to.c_str(), wait_timeout);
+        if (!sink->discovery().empty()) std::fprintf(stderr, "rvc: this publisher: %s\n", sink->discovery().c_str());
         return kIncomplete;
       }
     }

@@ -35,6 +35,9 @@ class Sink {
   virtual void put_eos(uint64_t last_seq) = 0;
   // Waits until at least n subscribers match; false on timeout.
   virtual bool wait_matched(size_t n, std::chrono::milliseconds timeout) { return true; }
+  // How subscribers can find this sink (what a user checks when none
+  // matches): locators, scouting, domain, interface. Empty for files.
+  virtual std::string discovery() const { return {}; }
   virtual void flush() {}
   // Called by long-running loops when no message is pending: a chance to make
   // buffered output visible (files) without a write per message.

@@ -257,8 +257,10 @@ fn check_mode(mode: &str) -> FfiResult<()> {
 
 /// rvc's embedded default. Zenoh's own default listens on every interface and
 /// multicasts scouting on the LAN; rvc must never leave loopback unless told,
-/// so peers/routers listen on 127.0.0.1 only and multicast scouting is off.
-/// Gossip scouting stays on: it only runs over links that already exist.
+/// so peers/routers listen on 127.0.0.1 only and multicast scouting runs on
+/// the loopback interface only: processes on one host find each other with
+/// no flags, nothing goes out on another interface. Gossip scouting stays
+/// on: it only runs over links that already exist.
 fn rvc_default_config(mode: &str) -> FfiResult<Config> {
     check_mode(mode)?;
     let mut cfg = Config::default();
@@ -270,7 +272,8 @@ fn rvc_default_config(mode: &str) -> FfiResult<Config> {
     };
     let listen: Vec<String> = listen.iter().map(|s| s.to_string()).collect();
     insert(&mut cfg, "listen/endpoints", &json_list(&listen))?;
-    insert(&mut cfg, "scouting/multicast/enabled", "false")?;
+    insert(&mut cfg, "scouting/multicast/enabled", "true")?;
+    insert(&mut cfg, "scouting/multicast/interface", "\"lo\"")?;
     insert(
         &mut cfg,
         "transport/link/tx/queue/congestion_control/block/wait_before_close",

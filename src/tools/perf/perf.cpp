@@ -73,7 +73,7 @@ std::shared_ptr<transport::ZenohSession> open_zenoh(const PerfOptions& o) {
   c.n_connect = connect.size();
   c.listen = listen.data();
   c.n_listen = listen.size();
-  c.multicast_scouting = z.multicast_scouting ? 1 : 0;
+  c.multicast_scouting = z.multicast_scouting;
   rvc_zenoh_config* cfg = nullptr;
   auto fail = [](const std::string& what) {
     throw transport::ZenohError("zenoh: " + what + ": " + rvc_zenoh_last_error());

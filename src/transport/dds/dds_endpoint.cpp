@@ -350,8 +350,12 @@ struct DdsSink::Impl {
   mutable std::mutex mu;  // put/put_eos may come from several threads
   std::string scratch;    // NUL-terminated copy of the payload for the C sample
   uint64_t written = 0;
+  std::string discovery;
 
   Impl(const std::string& topic, const DdsOptions& o) : ep(topic, o, true) {
+    discovery = "DDS domain " + std::to_string(o.domain) + " on interface " + o.interface + ", topic '" + ep.name +
+                "'. Subscribers must use the same domain, and a config pinned to the same interface "
+                "(rvc dds-config writes one for CYCLONEDDS_URI)";
     dds_qos_t* wq = make_qos(ep.qos, o.partition, false);
     writer = dds_create_writer(ep.group, ep.topic, wq, nullptr);
     dds_delete_qos(wq);
@@ -385,6 +389,8 @@ struct DdsSink::Impl {
 DdsSink::DdsSink(std::string topic, DdsOptions opts) : impl_(std::make_unique<Impl>(topic, opts)) {}
 
 DdsSink::~DdsSink() = default;
+
+std::string DdsSink::discovery() const { return impl_->discovery; }
 
 void DdsSink::put(std::string_view payload, uint64_t seq) {
   if (std::memchr(payload.data(), '\0', payload.size()))

@@ -62,6 +62,7 @@ class DdsSink final : public Sink {
   void put(std::string_view payload, uint64_t seq) override;
   void put_eos(uint64_t last_seq) override;
   bool wait_matched(size_t n, std::chrono::milliseconds timeout) override;
+  std::string discovery() const override;
   // Waits until every matched reliable reader acknowledged all samples.
   void flush() override;
   // Sends what write batching holds back (DdsOptions::write_batch).

@@ -56,7 +56,7 @@ typedef struct rvc_zenoh_config_opts {
   size_t n_connect;                /* 0 = keep base */
   const char* const* listen;
   size_t n_listen;                 /* 0 = keep base */
-  int multicast_scouting;          /* 0 = off, 1 = on (restricted to interface lo), -1 = keep base */
+  int multicast_scouting;          /* 0 = off, 1 = on (restricted to interface lo), -1 = keep base (rvc's default base: on, lo) */
 } rvc_zenoh_config_opts;
 
 int rvc_zenoh_config_build(const rvc_zenoh_config_opts* opts, rvc_zenoh_config** out);

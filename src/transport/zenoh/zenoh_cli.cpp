@@ -21,8 +21,12 @@ void add_zenoh_options(CLI::App& app, ZenohOptions& o) {
                  "for peers, tcp/127.0.0.1:7447 for routers)")
       ->delimiter(',')
       ->group(group);
-  app.add_flag("--multicast-scouting,!--no-multicast-scouting", o.multicast_scouting,
-               "Discover peers by UDP multicast on the loopback interface (default off)")
+  app.add_flag_callback("--multicast-scouting", [&o] { o.multicast_scouting = 1; },
+                        "Discover peers by UDP multicast on the loopback interface (the default without "
+                        "--zenoh-config)")
+      ->group(group);
+  app.add_flag_callback("--no-multicast-scouting", [&o] { o.multicast_scouting = 0; },
+                        "No multicast scouting: peers meet only through --connect/--listen endpoints")
       ->group(group);
   app.add_option("--zenoh-config", o.config_file,
                  "Zenoh JSON5 config file; the flags above override it")

@@ -78,7 +78,33 @@ std::unique_ptr<Source> make_zenoh_source(std::string keyexpr, const ZenohOption
 }
 
 std::unique_ptr<Sink> make_zenoh_sink(std::string keyexpr, const ZenohOptions& opts) {
-  return std::make_unique<ZenohSink>(ZenohSession::shared(opts), std::move(keyexpr), opts.express);
+  auto sink = std::make_unique<ZenohSink>(ZenohSession::shared(opts), std::move(keyexpr), opts.express);
+  sink->set_discovery(zenoh_discovery_summary(opts));
+  return sink;
+}
+
+std::string zenoh_discovery_summary(const ZenohOptions& opts) {
+  auto unquote = [](std::string s) {
+    if (s.size() >= 2 && s.front() == '"') s = s.substr(1, s.size() - 2);
+    return s;
+  };
+  std::string text = "Zenoh " + unquote(zenoh_config_json(opts, "mode"));
+  const std::string listen = zenoh_config_json(opts, "listen/endpoints"),
+                    connect = zenoh_config_json(opts, "connect/endpoints");
+  if (listen != "[]") text += ", listening on " + listen + (listen.find(":0\"") != std::string::npos ? " (:0 = a free port)" : "");
+  if (connect != "[]") text += ", connecting to " + connect;
+  if (zenoh_config_json(opts, "scouting/multicast/enabled") == "true")
+  {
+    std::string address = unquote(zenoh_config_json(opts, "scouting/multicast/address"));
+    if (address == "null") address = "224.0.0.224:7446";  // Zenoh's default group
+    text += ", multicast scouting on " + address + " via " +
+            unquote(zenoh_config_json(opts, "scouting/multicast/interface"));
+  }
+  else
+    text += ", no multicast scouting";
+  text += ". Peers meet by multicast scouting on this host, or by --connect to a --listen endpoint "
+          "(or a router: rvc router, --connect tcp/HOST:7447)";
+  return text;
 }
 
 // ---- router ------------------------------------------------------------------

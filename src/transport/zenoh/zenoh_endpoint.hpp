@@ -47,12 +47,19 @@ class ZenohSink : public Sink {
   // subscribers answered than had announced themselves, or on timeout.
   void flush() override;
   ZenohPublisher& publisher() { return pub_; }
+  std::string discovery() const override { return discovery_; }
+  void set_discovery(std::string text) { discovery_ = std::move(text); }
 
  private:
   std::shared_ptr<ZenohSession> session_;
   std::string keyexpr_;
   ZenohPublisher pub_;
+  std::string discovery_;
 };
+
+// One line on how a session with these options meets others: its mode,
+// where it listens and connects, whether it scouts by multicast and where.
+std::string zenoh_discovery_summary(const ZenohOptions& opts);
 
 // Both share one session per distinct ZenohOptions in the process. Throw
 // ZenohError when the session cannot be opened or the key is invalid.

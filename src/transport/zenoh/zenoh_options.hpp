@@ -1,7 +1,8 @@
 // How an rvc process joins a Zenoh network, as set on the command line.
-// Without a config file rvc's defaults keep everything on loopback: peers
-// listen on tcp/127.0.0.1:0, routers on tcp/127.0.0.1:7447, multicast
-// scouting is off. See docs/zenoh.md.
+// Without a config file rvc's defaults find each other on one host and keep
+// everything on loopback: peers listen on tcp/127.0.0.1:0, routers on
+// tcp/127.0.0.1:7447, and multicast scouting runs on the loopback interface
+// only (224.0.0.224:7446 via lo). See docs/zenoh.md.
 #pragma once
 
 #include <string>
@@ -17,9 +18,9 @@ struct ZenohOptions {
   std::string mode = "peer";         // peer | client | router
   std::vector<std::string> connect;  // endpoints such as tcp/127.0.0.1:7447
   std::vector<std::string> listen;   // empty = default for the mode (see above)
-  // Off unless asked for, even when the config file enables it; when on, it
-  // is confined to the loopback interface.
-  bool multicast_scouting = false;
+  // -1: the default — on, confined to the loopback interface, without a
+  // config file; the file's own setting with one. 1: on (lo). 0: off.
+  int multicast_scouting = -1;
   std::string config_file;  // JSON5 Zenoh config; explicit flags override it
   // With a config file, its mode is kept unless --mode was given.
   bool mode_explicit = false;

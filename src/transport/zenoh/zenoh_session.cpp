@@ -37,7 +37,7 @@ ConfigPtr build_config(const ZenohOptions& o) {
   c.n_connect = connect.size();
   c.listen = listen.data();
   c.n_listen = listen.size();
-  c.multicast_scouting = o.multicast_scouting ? 1 : 0;
+  c.multicast_scouting = o.multicast_scouting;
   rvc_zenoh_config* cfg = nullptr;
   check(rvc_zenoh_config_build(&c, &cfg), "building config");
   return ConfigPtr(cfg);
@@ -52,7 +52,7 @@ std::string take_string(char* s) {
 std::string registry_key(const ZenohOptions& o) {
   // '\x1f' cannot appear in endpoints, modes or sane paths.
   std::string k = o.mode + '\x1f' + (o.mode_explicit ? "1" : "0") + '\x1f' +
-                  (o.multicast_scouting ? "1" : "0") + '\x1f' + o.config_file + '\x1f';
+                  std::to_string(o.multicast_scouting) + '\x1f' + o.config_file + '\x1f';
   for (const auto& e : o.connect) k += "c:" + e + '\x1f';
   for (const auto& e : o.listen) k += "l:" + e + '\x1f';
   return k;

@@ -130,12 +130,14 @@ TEST(ZenohConfig, DefaultsStayOnLoopback) {
   ZenohOptions peer;
   EXPECT_EQ(zenoh_config_json(peer, "mode"), "\"peer\"");
   EXPECT_EQ(zenoh_config_json(peer, "listen/endpoints"), "[\"tcp/127.0.0.1:0\"]");
-  EXPECT_EQ(zenoh_config_json(peer, "scouting/multicast/enabled"), "false");
+  // Multicast scouting on by default so one host needs no flags, but only on lo.
+  EXPECT_EQ(zenoh_config_json(peer, "scouting/multicast/enabled"), "true");
+  EXPECT_EQ(zenoh_config_json(peer, "scouting/multicast/interface"), "\"lo\"");
 
   ZenohOptions router;
   router.mode = "router";
   EXPECT_EQ(zenoh_config_json(router, "listen/endpoints"), "[\"tcp/127.0.0.1:7447\"]");
-  EXPECT_EQ(zenoh_config_json(router, "scouting/multicast/enabled"), "false");
+  EXPECT_EQ(zenoh_config_json(router, "scouting/multicast/interface"), "\"lo\"");
 
   ZenohOptions client;
   client.mode = "client";
@@ -144,7 +146,7 @@ TEST(ZenohConfig, DefaultsStayOnLoopback) {
   EXPECT_EQ(zenoh_config_json(client, "connect/endpoints"), "[\"tcp/127.0.0.1:7447\"]");
 
   ZenohOptions mc;
-  mc.multicast_scouting = true;
+  mc.multicast_scouting = 1;
   EXPECT_EQ(zenoh_config_json(mc, "scouting/multicast/enabled"), "true");
   EXPECT_EQ(zenoh_config_json(mc, "scouting/multicast/interface"), "\"lo\"");
 }
@@ -163,7 +165,9 @@ TEST(ZenohConfig, ConfigFileThenFlags) {
   o.config_file = path;
   EXPECT_EQ(zenoh_config_json(o, "mode"), "\"client\"");  // file's mode kept
   EXPECT_EQ(zenoh_config_json(o, "connect/endpoints"), "[\"tcp/127.0.0.1:1\"]");
-  EXPECT_EQ(zenoh_config_json(o, "scouting/multicast/enabled"), "false");  // forced off
+  EXPECT_EQ(zenoh_config_json(o, "scouting/multicast/enabled"), "true");  // the file's setting kept
+  o.multicast_scouting = 0;
+  EXPECT_EQ(zenoh_config_json(o, "scouting/multicast/enabled"), "false");  // unless a flag says otherwise
   o.mode = "peer";
   o.mode_explicit = true;
   o.connect = {"tcp/127.0.0.1:2"};
@@ -203,7 +207,7 @@ TEST(ZenohCli, RegistersFlags) {
   EXPECT_TRUE(o.mode_explicit);
   EXPECT_EQ(o.listen, (std::vector<std::string>{"tcp/127.0.0.1:7000", "tcp/127.0.0.1:7001"}));
   EXPECT_EQ(o.connect, (std::vector<std::string>{"tcp/127.0.0.1:7447"}));
-  EXPECT_TRUE(o.multicast_scouting);
+  EXPECT_EQ(o.multicast_scouting, 1);
   EXPECT_TRUE(o.express);
 
   CLI::App app2;
@@ -211,7 +215,7 @@ TEST(ZenohCli, RegistersFlags) {
   add_zenoh_options(app2, o2);
   const char* argv2[] = {"t", "--no-multicast-scouting"};
   app2.parse(2, argv2);
-  EXPECT_FALSE(o2.multicast_scouting);
+  EXPECT_EQ(o2.multicast_scouting, 0);
   EXPECT_FALSE(o2.mode_explicit);
   EXPECT_EQ(o2.mode, "peer");
   const char* argv3[] = {"t", "--mode", "broker"};
