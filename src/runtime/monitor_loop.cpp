@@ -58,6 +58,8 @@ std::string MonitorLoop::stats_json() const {
       .add("gaps", counters_.gaps)
       .add("duplicates", counters_.duplicates)
       .add("last_seq", counters_.last_seq)
+      .add("publishers", counters_.publishers())
+      .add("publisher_restarts", counters_.restarts)
       .add("verdicts", outputs_.count())
       .add("violations", pipeline_.checker().violations())
       .add("eos", eos_)
@@ -104,11 +106,12 @@ void MonitorLoop::process(transport::Source& source) {
       for (size_t i = 0; i < count; ++i) {
         const transport::OwnedFrame& f = batch[i];
         if (f.eos) {
-          if (options_.sequence_numbers) counters_.on_eos(f.seq);
-          eos_ = true;
+          // Several publishers: the stream ends when each has ended.
+          if (options_.sequence_numbers) counters_.on_eos(f.seq, f.publisher);
+          eos_ = !options_.sequence_numbers || counters_.all_ended();
           continue;
         }
-        if (options_.sequence_numbers) counters_.on_seq(f.seq);
+        if (options_.sequence_numbers) counters_.on_seq(f.seq, f.publisher);
         else ++counters_.received;
         pipeline_.feed(f.payload, f.seq ? f.seq : counters_.received);
       }

@@ -12,6 +12,7 @@ struct Frame {
   std::string_view payload;  // borrowed: valid only during the callback
   uint64_t seq = 0;          // publisher's sequence number (1-based), 0 if unknown
   bool eos = false;          // end-of-stream marker: payload is empty, seq = last data seq
+  uint64_t publisher = 0;    // who sent it (DDS publication handle, rvc's Zenoh publisher id); 0 if unknown
 };
 
 // Called on a transport thread. Must copy what it keeps and return quickly.

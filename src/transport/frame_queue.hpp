@@ -22,6 +22,7 @@ struct OwnedFrame {
   std::string payload;
   uint64_t seq = 0;
   bool eos = false;
+  uint64_t publisher = 0;
 };
 
 class FrameQueue {
@@ -38,6 +39,7 @@ class FrameQueue {
     slot.payload.assign(frame.payload.data(), frame.payload.size());
     slot.seq = frame.seq;
     slot.eos = frame.eos;
+    slot.publisher = frame.publisher;
     if (incoming_count_ == 1) not_empty_.notify_one();
   }
 

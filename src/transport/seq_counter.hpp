@@ -1,30 +1,91 @@
 // Loss accounting from publisher sequence numbers: received, gaps (missing
-// numbers), duplicates (numbers seen again or going backwards). Identical for
-// every transport, so Zenoh and DDS report the same counters.
+// numbers), duplicates (numbers seen again or going backwards), counted per
+// publisher, so two publishers on one topic do not read as each other's
+// duplicates, and a publisher that starts again from 1 reads as a restart,
+// not as a flood of duplicates. Identical for every transport, so Zenoh and
+// DDS report the same counters.
 #pragma once
 
 #include <cstdint>
+#include <cstddef>
+#include <unordered_map>
 
 namespace rvc::transport {
 
-struct SeqCounters {
+class SeqCounters {
+ public:
+  // Totals over all publishers.
   uint64_t received = 0;
   uint64_t gaps = 0;        // sequence numbers skipped (lost or never sent)
   uint64_t duplicates = 0;  // repeated or backwards sequence numbers
   uint64_t rejected = 0;    // payloads the decoder refused (set by the pipeline)
-  uint64_t last_seq = 0;
+  uint64_t last_seq = 0;    // messages announced: the sum of each publisher's last sequence number
+  uint64_t restarts = 0;    // a publisher that began again (from 1, or a new one after an end of stream)
 
-  void on_seq(uint64_t seq) {
-    ++received;
-    if (seq == 0) return;  // publisher sent no sequence number
-    if (seq <= last_seq) { ++duplicates; return; }
-    gaps += seq - last_seq - 1;
-    last_seq = seq;
-  }
-  // At end of stream the publisher tells its last seq: anything after ours is lost.
-  void on_eos(uint64_t publisher_last_seq) {
-    if (publisher_last_seq > last_seq) { gaps += publisher_last_seq - last_seq; last_seq = publisher_last_seq; }
-  }
+  // One message; `publisher` identifies its sender (0: unknown — counted, not
+  // accounted). seq 0: the publisher sent no sequence number.
+  void on_seq(uint64_t seq, uint64_t publisher = 0);
+  // End of stream: the publisher tells its last seq; anything after ours is lost.
+  void on_eos(uint64_t publisher_last_seq, uint64_t publisher = 0);
+
+  size_t publishers() const { return by_publisher_.size(); }
+  // Every publisher seen so far has sent its end-of-stream marker.
+  bool all_ended() const { return ended_ == by_publisher_.size(); }
+
+ private:
+  struct Publisher {
+    uint64_t last_seq = 0;
+    bool ended = false;
+  };
+  Publisher& publisher(uint64_t id, uint64_t seq);
+
+  std::unordered_map<uint64_t, Publisher> by_publisher_;
+  size_t ended_ = 0;
+  bool any_ended_ = false;  // some publisher ended: a newcomer after it is a restart
 };
+
+// Header-only: the transports' own test probes use it without the rest of rvc.
+inline SeqCounters::Publisher& SeqCounters::publisher(uint64_t id, uint64_t seq) {
+  auto [it, fresh] = by_publisher_.try_emplace(id);
+  Publisher& p = it->second;
+  if (fresh) {
+    if (any_ended_) ++restarts;  // a publisher that ended, started again (DDS and Zenoh give it a new id)
+    return p;
+  }
+  // The same publisher numbering from the start again: it restarted.
+  if (seq == 1 && (p.last_seq > 1 || p.ended)) {
+    ++restarts;
+    if (p.ended) --ended_;
+    p = Publisher{};
+  }
+  return p;
+}
+
+inline void SeqCounters::on_seq(uint64_t seq, uint64_t id) {
+  ++received;
+  if (seq == 0) return;  // publisher sent no sequence number
+  Publisher& p = publisher(id, seq);
+  if (seq <= p.last_seq) {
+    ++duplicates;
+    return;
+  }
+  gaps += seq - p.last_seq - 1;
+  last_seq += seq - p.last_seq;
+  p.last_seq = seq;
+}
+
+inline void SeqCounters::on_eos(uint64_t publisher_last_seq, uint64_t id) {
+  Publisher& p = publisher(id, 0);
+  if (publisher_last_seq > p.last_seq) {
+    gaps += publisher_last_seq - p.last_seq;
+    last_seq += publisher_last_seq - p.last_seq;
+    p.last_seq = publisher_last_seq;
+  }
+  if (!p.ended) {
+    p.ended = true;
+    ++ended_;
+  }
+  any_ended_ = true;
+}
 
 }  // namespace rvc::transport

@@ -230,6 +230,7 @@ struct DdsSource::Impl {
     }
     std::string_view payload(data);
     Frame f;
+    f.publisher = info.publication_handle;
     if (auto eos = dds::parse_eos(payload)) {
       f.eos = true;
       f.seq = ep.frame_type ? eos->last_seq : eos->count;

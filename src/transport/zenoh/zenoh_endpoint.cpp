@@ -1,6 +1,7 @@
 #include "transport/zenoh/zenoh_endpoint.hpp"
 
 #include <cstdio>
+#include <random>
 #include <mutex>
 #include <stdexcept>
 #include <thread>
@@ -28,6 +29,7 @@ void ZenohSource::start(FrameHandler handler) {
     Frame f;
     f.seq = a.seq;
     f.eos = a.eos;
+    f.publisher = a.publisher;
     if (!a.eos) f.payload = s.payload;  // an EOS marker carries no data
     std::lock_guard lock(*mu);
     handler(f);
@@ -44,15 +46,22 @@ void ZenohSource::stop() {
 // ---- ZenohSink -------------------------------------------------------------
 
 ZenohSink::ZenohSink(std::shared_ptr<ZenohSession> session, std::string keyexpr, bool express)
-    : session_(session), keyexpr_(keyexpr), pub_(std::move(session), keyexpr, express) {}
+    : session_(session), keyexpr_(keyexpr), pub_(std::move(session), keyexpr, express), id_(random_publisher_id()) {}
+
+uint64_t ZenohSink::random_publisher_id() {
+  std::random_device rd;
+  uint64_t id = 0;
+  while (id == 0) id = (static_cast<uint64_t>(rd()) << 32) ^ rd();  // 0 means "unknown"
+  return id;
+}
 
 void ZenohSink::put(std::string_view payload, uint64_t seq) {
-  const auto att = encode_seq_attachment(seq, false);
+  const auto att = encode_seq_attachment(seq, false, id_);
   pub_.put(payload, std::string_view(reinterpret_cast<const char*>(att.data()), att.size()));
 }
 
 void ZenohSink::put_eos(uint64_t last_seq) {
-  const auto att = encode_seq_attachment(last_seq, true);
+  const auto att = encode_seq_attachment(last_seq, true, id_);
   pub_.put({}, std::string_view(reinterpret_cast<const char*>(att.data()), att.size()));
 }
 

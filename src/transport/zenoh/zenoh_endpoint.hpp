@@ -55,6 +55,8 @@ class ZenohSink : public Sink {
   std::string keyexpr_;
   ZenohPublisher pub_;
   std::string discovery_;
+  uint64_t id_;  // this publisher's id in every attachment (seq_attachment.hpp)
+  static uint64_t random_publisher_id();
 };
 
 // One line on how a session with these options meets others: its mode,

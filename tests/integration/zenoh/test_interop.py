@@ -206,14 +206,19 @@ def check_probe_sub_output(lines, n, plain=2):
 
 def check_python_received(samples, n, prefix="msg-"):
     assert len(samples) == n + 1
+    publishers = set()
     for i, (payload, att) in enumerate(samples[:n], start=1):
         assert payload == f"{prefix}{i}".encode()
-        assert att is not None and len(att) == 9
-        seq, flags = struct.unpack("<QB", att)
+        assert att is not None and len(att) == 17  # seq, flags, publisher id (docs/zenoh.md)
+        seq, flags, publisher = struct.unpack("<QBQ", att)
         assert (seq, flags) == (i, 0)
+        publishers.add(publisher)
     payload, att = samples[n]
     assert payload == b""
-    assert struct.unpack("<QB", att) == (n, 1)
+    seq, flags, publisher = struct.unpack("<QBQ", att)
+    assert (seq, flags) == (n, 1)
+    publishers.add(publisher)
+    assert len(publishers) == 1 and 0 not in publishers  # one rvc sink, one nonzero id
 
 
 # ---- peer to peer ------------------------------------------------------------

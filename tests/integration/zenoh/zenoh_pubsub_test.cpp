@@ -105,8 +105,12 @@ std::string binary_payload(size_t i, size_t len) {
 }  // namespace
 
 TEST(SeqAttachment, RoundTripAndLenientDecode) {
-  auto a = encode_seq_attachment(0x0102030405060708ULL, true);
-  ASSERT_EQ(a.size(), 9u);
+  auto a = encode_seq_attachment(0x0102030405060708ULL, true, 0x1122334455667788ULL);
+  ASSERT_EQ(a.size(), 17u);
+  EXPECT_EQ(a[9], 0x88);  // publisher id, little-endian
+  EXPECT_EQ(a[16], 0x11);
+  EXPECT_EQ(decode_seq_attachment(a.data(), a.size()).publisher, 0x1122334455667788ULL);
+  EXPECT_EQ(decode_seq_attachment(a.data(), 9).publisher, 0u);  // the 9-byte form: unknown publisher
   EXPECT_EQ(a[0], 0x08);  // little-endian
   EXPECT_EQ(a[7], 0x01);
   EXPECT_EQ(a[8], kSeqFlagEos);
