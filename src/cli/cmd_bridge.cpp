@@ -46,10 +46,14 @@ struct BridgeCommand {
     }
     std::vector<std::unique_ptr<Route>> routes;
     for (size_t i = 0; i < uris.size(); i += 2) {
-      if (uris[i] == uris[i + 1]) {
-        std::fprintf(stderr, "rvc bridge: route %s -> %s would feed itself\n", uris[i].c_str(), uris[i + 1].c_str());
-        return kUsage;
-      }
+      // A route whose output reaches its own input (or another route's
+      // input) forwards its own messages without end.
+      for (size_t j = 0; j < uris.size(); j += 2)
+        if (transport::endpoints_overlap(uris[j], uris[i + 1])) {
+          std::fprintf(stderr, "rvc bridge: route %s -> %s would feed %s\n", uris[i].c_str(), uris[i + 1].c_str(),
+                       j == i ? "itself" : ("the route from " + uris[j]).c_str());
+          return kUsage;
+        }
       auto r = std::make_unique<Route>();
       r->from = uris[i];
       r->to = uris[i + 1];

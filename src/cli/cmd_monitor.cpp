@@ -11,7 +11,6 @@
 #include "cli/check_options.hpp"
 #include "cli/commands.hpp"
 #include "cli/signals.hpp"
-#include "runtime/check_stream.hpp"
 #include "runtime/monitor_loop.hpp"
 #include "transport/transport_options.hpp"
 
@@ -31,14 +30,13 @@ struct MonitorCommand {
   size_t wait_subscribers = 0;  // per network output, before subscribing to the input
   double wait_timeout = 10;
 
-  // A file written by an output while it is read as the input would feed
-  // the monitor its own verdicts.
+  // An output that the input would read back (the same file, an
+  // intersecting key expression, the same topic) feeds the monitor its own
+  // verdicts without end.
   bool refuse_own_input(const std::string& output) const {
-    if (transport::scheme_of(input) != "file" || transport::scheme_of(output) != "file") return false;
-    auto path = [](const std::string& uri) { return uri.rfind("file:", 0) == 0 ? uri.substr(5) : uri; };
-    if (path(input) == "-" || path(output) == "-" || !runtime::same_regular_file(path(input), path(output)))
-      return false;
-    std::fprintf(stderr, "rvc: output '%s' is the input being read: refusing to overwrite it\n", output.c_str());
+    if (!transport::endpoints_overlap(input, output)) return false;
+    std::fprintf(stderr, "rvc: output '%s' would be read back by the input '%s': refusing to monitor its own output\n",
+                 output.c_str(), input.c_str());
     return true;
   }
 

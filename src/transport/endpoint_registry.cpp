@@ -1,9 +1,12 @@
 // Maps endpoint URIs to transports. The only place that knows them all.
+#include <sys/stat.h>
+
 #include <stdexcept>
 
 #include "transport/file_endpoint.hpp"
 #include "transport/transport_options.hpp"
 #ifdef RVC_HAVE_ZENOH
+#include "transport/zenoh/rvc_zenoh.h"
 #include "transport/zenoh/zenoh_endpoint.hpp"
 #endif
 #ifdef RVC_HAVE_DDS
@@ -40,6 +43,29 @@ Parsed parse(const std::string& uri) {
 }  // namespace
 
 std::string scheme_of(const std::string& uri) { return parse(uri).scheme; }
+
+bool endpoints_overlap(const std::string& a, const std::string& b) {
+  Parsed pa = parse(a), pb = parse(b);
+  if (pa.scheme != pb.scheme) return false;
+  if (pa.scheme == "file") {
+    if (pa.rest == "-" || pb.rest == "-") return false;  // stdin and stdout are different streams
+    struct stat sa, sb;
+    if (::stat(pa.rest.c_str(), &sa) != 0 || ::stat(pb.rest.c_str(), &sb) != 0) return pa.rest == pb.rest;
+    return S_ISREG(sa.st_mode) && sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+  }
+  if (pa.scheme == "dds") {
+    // ROS 2 names: "/a/b" and "a/b" are the same topic (rt/a/b).
+    auto strip = [](const std::string& t) { return t.front() == '/' ? t.substr(1) : t; };
+    return strip(pa.rest) == strip(pb.rest);
+  }
+#ifdef RVC_HAVE_ZENOH
+  int rc = rvc_zenoh_keyexpr_intersects(pa.rest.c_str(), pb.rest.c_str());
+  if (rc < 0) throw std::invalid_argument(std::string("zenoh: ") + rvc_zenoh_last_error());
+  return rc == 1;
+#else
+  return pa.rest == pb.rest;
+#endif
+}
 
 void add_transport_options(CLI::App& app, TransportOptions& options) {
 #ifdef RVC_HAVE_ZENOH

@@ -37,4 +37,10 @@ std::unique_ptr<Sink> open_sink(const std::string& uri, const TransportOptions& 
 // "zenoh", "dds" or "file".
 std::string scheme_of(const std::string& uri);
 
+// Whether what is published on endpoint `b` would be received on endpoint
+// `a` (or the other way round): intersecting Zenoh key expressions, the same
+// DDS topic, the same file. A monitor or bridge reading its own output would
+// feed itself without end. Throws std::invalid_argument for a bad URI.
+bool endpoints_overlap(const std::string& a, const std::string& b);
+
 }  // namespace rvc::transport

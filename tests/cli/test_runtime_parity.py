@@ -81,7 +81,7 @@ def test_output_naming_the_input_is_refused(rvc, tmp_path):
         c = run(rvc, "check", "--spec", "{p}", str(trace), "-o", out)
         assert c.returncode == 2 and "refusing to overwrite" in c.stderr, c.stderr
         m = run(rvc, "monitor", "--spec", "{p}", "--input", f"file:{trace}", "--output", out)
-        assert m.returncode == 2 and "refusing to overwrite" in m.stderr, m.stderr
+        assert m.returncode == 2 and "refusing to monitor its own output" in m.stderr, m.stderr
     assert trace.read_text() == content
 
 

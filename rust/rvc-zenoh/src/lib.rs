@@ -579,6 +579,17 @@ fn keyexpr(s: &str) -> FfiResult<KeyExpr<'static>> {
     KeyExpr::autocanonize(s.to_owned()).map_err(|e| einval(format!("key expression '{s}': {e}")))
 }
 
+/// 1 if some key matches both key expressions (a subscriber on `a` would
+/// receive what is put on `b`), 0 if none does, negative on a bad expression.
+#[no_mangle]
+pub unsafe extern "C" fn rvc_zenoh_keyexpr_intersects(a: *const c_char, b: *const c_char) -> c_int {
+    guard(|| {
+        let ka = keyexpr(cstr(a, "keyexpr a")?)?;
+        let kb = keyexpr(cstr(b, "keyexpr b")?)?;
+        Ok(ka.intersects(&kb) as c_int)
+    })
+}
+
 /// Declares a subscriber on `keyexpr`. `cb` runs on a Zenoh thread with
 /// borrowed buffers; it must not block for long nor call back into this
 /// library for the same subscriber. With `announce` != 0 the subscriber also

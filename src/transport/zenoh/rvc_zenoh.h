@@ -37,6 +37,9 @@ typedef struct rvc_zenoh_subscriber rvc_zenoh_subscriber;
 typedef struct rvc_zenoh_publisher rvc_zenoh_publisher;
 
 const char* rvc_zenoh_last_error(void);
+
+/* 1 if some key matches both key expressions, 0 if none, < 0 for a bad one. */
+int rvc_zenoh_keyexpr_intersects(const char* a, const char* b);
 void rvc_zenoh_string_free(char* s);
 
 /* Zenoh's log output to stderr. RUST_LOG wins over `fallback_filter`

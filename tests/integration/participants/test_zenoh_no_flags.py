@@ -86,3 +86,14 @@ def test_python_peer_with_its_own_defaults(rvc, tmp_path, netns):
     # 199 messages, then the end-of-stream marker (an empty payload with rvc's attachment).
     assert got[:-1] == trace(tmp_path, 199).read_text().splitlines()
     assert got[-1] == ""
+
+
+def test_monitor_refuses_to_read_its_own_verdicts(rvc):
+    need_zenoh(rvc)
+    r = subprocess.run([rvc, "monitor", "--spec", "{p}", "--input", "zenoh:loop/**", "--output", "zenoh:loop/verdicts"],
+                       capture_output=True, text=True, timeout=30)
+    assert r.returncode == 2 and "refusing to monitor its own output" in r.stderr, r.stderr
+    r = subprocess.run([rvc, "monitor", "--spec", "{p}", "--input", "zenoh:in/**", "--output", "zenoh:loop/verdicts",
+                        "--stats-output", "zenoh:in/stats", "--idle-timeout", "0.1"],
+                       capture_output=True, text=True, timeout=30)
+    assert r.returncode == 2 and "'zenoh:in/stats'" in r.stderr, r.stderr
