@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "cli/commands.hpp"
+#include "cli/transport_flags.hpp"
 #include "io/json_writer.hpp"
 #include "cli/signals.hpp"
 #include "transport/transport_options.hpp"
@@ -142,7 +143,7 @@ Runner register_bridge(CLI::App& app) {
   sub->add_option("--wait-timeout", cmd->wait_timeout, "Seconds to wait for them")->capture_default_str();
   sub->add_flag("--exit-on-eos", cmd->exit_on_eos, "Exit once every route forwarded an end-of-stream marker");
   sub->add_option("--stats-interval", cmd->stats_interval, "Print forwarded counts every S seconds (stderr)");
-  transport::add_transport_options(*sub, cmd->transports);
+  add_transport_options(*sub, cmd->transports);
   return [cmd] { return cmd->run(); };
 }
 

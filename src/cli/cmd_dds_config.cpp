@@ -7,6 +7,7 @@
 #include <string>
 
 #include "cli/commands.hpp"
+#include "cli/transport_flags.hpp"
 #include "transport/dds/dds_options.hpp"
 
 namespace rvc::cli {
@@ -18,7 +19,7 @@ Runner register_dds_config(CLI::App& app) {
   };
   auto cmd = std::make_shared<Cmd>();
   CLI::App* sub = app.add_subcommand("dds-config", "Print the CycloneDDS XML rvc uses (for CYCLONEDDS_URI of other programs)");
-  transport::add_dds_options(*sub, cmd->dds);
+  add_dds_options(*sub, cmd->dds);
   sub->add_option("--output,-o", cmd->output, "File to write (- for stdout)")->capture_default_str();
   return [cmd] {
     std::string xml = transport::dds::generated_config_xml(cmd->dds);

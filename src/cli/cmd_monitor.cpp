@@ -10,6 +10,7 @@
 
 #include "cli/check_options.hpp"
 #include "cli/commands.hpp"
+#include "cli/transport_flags.hpp"
 #include "cli/signals.hpp"
 #include "runtime/monitor_loop.hpp"
 #include "transport/transport_options.hpp"
@@ -114,7 +115,7 @@ Runner register_monitor(CLI::App& app) {
       ->capture_default_str();
   sub->add_option("--wait-timeout", cmd->wait_timeout, "Seconds to wait for them")->capture_default_str();
   sub->add_option("--queue", cmd->queue_capacity, "Messages buffered between transport and engine")->capture_default_str();
-  transport::add_transport_options(*sub, cmd->transports);
+  add_transport_options(*sub, cmd->transports);
   sub->footer(
       "Exit status: 0 all held, 1 a property was violated, 2 usage/spec error, 3 messages rejected, 4 messages lost,\n"
       "5 runtime failure (an output could not be written), 6 incomplete (nothing received, or no end-of-stream\n"

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "cli/commands.hpp"
+#include "cli/transport_flags.hpp"
 #include "cli/signals.hpp"
 #include "tools/perf/perf.hpp"
 #include "transport/transport_options.hpp"
@@ -93,7 +94,7 @@ void add_role(PerfCommand& cmd, CLI::App& perf, const std::string& name, const s
       ->capture_default_str();
   s->add_option("--report-interval", r.opts.report_interval, "Progress line period on stderr (0 = none)")
       ->capture_default_str();
-  transport::add_transport_options(*s, r.opts.transports);
+  add_transport_options(*s, r.opts.transports);
 }
 
 }  // namespace

@@ -16,6 +16,7 @@
 #include <thread>
 
 #include "cli/commands.hpp"
+#include "cli/transport_flags.hpp"
 #include "cli/signals.hpp"
 #include "io/json_writer.hpp"
 #include "transport/transport_options.hpp"
@@ -228,7 +229,7 @@ Runner register_replay(CLI::App& app) {
   sub->add_flag("!--no-progress", cmd->progress, "No progress line on a terminal");
   sub->add_option("--latency-from", cmd->latency_from,
                   "Verdict endpoint of an `rvc monitor --all`: report publish-to-verdict latency percentiles");
-  transport::add_transport_options(*sub, cmd->transports);
+  add_transport_options(*sub, cmd->transports);
   return [cmd] { return cmd->run(); };
 }
 

@@ -7,6 +7,7 @@
 #include <thread>
 
 #include "cli/commands.hpp"
+#include "cli/transport_flags.hpp"
 #include "cli/signals.hpp"
 #include "transport/zenoh/zenoh_endpoint.hpp"
 
@@ -15,7 +16,7 @@ namespace rvc::cli {
 Runner register_router(CLI::App& app) {
   auto opts = std::make_shared<transport::ZenohOptions>();
   CLI::App* sub = app.add_subcommand("router", "Run a Zenoh router (default: listen on tcp/127.0.0.1:7447)");
-  transport::add_zenoh_options(*sub, *opts);
+  add_zenoh_options(*sub, *opts);
   return [opts] {
     opts->mode = "router";
     install_stop_signals();

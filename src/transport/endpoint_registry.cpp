@@ -67,17 +67,6 @@ bool endpoints_overlap(const std::string& a, const std::string& b) {
 #endif
 }
 
-void add_transport_options(CLI::App& app, TransportOptions& options) {
-#ifdef RVC_HAVE_ZENOH
-  add_zenoh_options(app, options.zenoh);
-#endif
-#ifdef RVC_HAVE_DDS
-  add_dds_options(app, options.dds);
-#endif
-  (void)app;
-  (void)options;
-}
-
 std::unique_ptr<Source> open_source(const std::string& uri, const TransportOptions& options) {
   Parsed p = parse(uri);
   if (p.scheme == "file") return std::make_unique<FileSource>(p.rest);

@@ -1,8 +1,7 @@
-// Options of every transport compiled in, registered on a subcommand so that
-// `rvc monitor`, `rvc replay` and `rvc perf` take the same flags.
+// Options of every transport compiled in: plain structs. Their command-line
+// flags are registered by src/cli/transport_flags.hpp, so that `rvc
+// monitor`, `rvc replay` and `rvc perf` take the same flags.
 #pragma once
-
-#include <CLI/CLI.hpp>
 
 #include <memory>
 #include <string>
@@ -25,8 +24,6 @@ struct TransportOptions {
   DdsOptions dds;
 #endif
 };
-
-void add_transport_options(CLI::App& app, TransportOptions& options);
 
 // Endpoint URIs: file:PATH | PATH | - | zenoh:KEYEXPR | dds:TOPIC.
 // Throw std::invalid_argument naming the problem (unknown scheme, a transport

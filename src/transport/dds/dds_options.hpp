@@ -11,10 +11,6 @@
 #include <string_view>
 #include <vector>
 
-namespace CLI {
-class App;
-}
-
 namespace rvc::transport {
 
 struct DdsOptions {
@@ -40,9 +36,6 @@ struct DdsOptions {
   bool deliver_on_receive_thread = false;
 };
 
-// Registers --domain, --partition, --qos, --dds-type, --dds-interface,
-// --dds-peer, --dds-config, --dds-trace and --no-ros2-names on app.
-void add_dds_options(CLI::App& app, DdsOptions& opts);
 
 namespace dds {
 

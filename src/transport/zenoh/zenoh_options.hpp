@@ -8,10 +8,6 @@
 #include <string>
 #include <vector>
 
-namespace CLI {
-class App;
-}
-
 namespace rvc::transport {
 
 struct ZenohOptions {
@@ -27,8 +23,5 @@ struct ZenohOptions {
   bool express = false;  // publishers: send each sample at once, no batching
 };
 
-// Registers --mode, --connect, --listen, --multicast-scouting /
-// --no-multicast-scouting, --zenoh-config FILE and --express on `app`.
-void add_zenoh_options(CLI::App& app, ZenohOptions& opts);
 
 }  // namespace rvc::transport

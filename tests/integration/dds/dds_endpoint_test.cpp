@@ -23,10 +23,12 @@
 #include <thread>
 #include <vector>
 
+#include "cli/transport_flags.hpp"
 #include "transport/dds/dds_endpoint.hpp"
 #include "transport/seq_counter.hpp"
 
 using namespace rvc::transport;
+using namespace rvc::cli;  // add_*_options: the transports' flags
 using namespace std::chrono_literals;
 namespace fs = std::filesystem;
 

@@ -16,10 +16,12 @@
 #include <set>
 #include <string>
 
+#include "cli/transport_flags.hpp"
 #include "transport/dds/dds_endpoint.hpp"
 #include "transport/seq_counter.hpp"
 
 using namespace rvc::transport;
+using namespace rvc::cli;  // add_*_options: the transports' flags
 
 namespace {
 

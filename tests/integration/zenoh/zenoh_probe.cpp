@@ -21,9 +21,11 @@
 #include <mutex>
 #include <string>
 
+#include "cli/transport_flags.hpp"
 #include "transport/zenoh/zenoh_endpoint.hpp"
 
 using namespace rvc::transport;
+using namespace rvc::cli;  // add_*_options: the transports' flags
 
 namespace {
 

@@ -18,11 +18,13 @@
 
 #include <gtest/gtest.h>
 
+#include "cli/transport_flags.hpp"
 #include "transport/seq_counter.hpp"
 #include "transport/zenoh/seq_attachment.hpp"
 #include "transport/zenoh/zenoh_endpoint.hpp"
 
 using namespace rvc::transport;
+using namespace rvc::cli;  // add_*_options: the transports' flags
 using namespace std::chrono_literals;
 
 namespace {

@@ -1,12 +1,12 @@
-// Command-line flags for Zenoh endpoints (CLI11). Kept apart from the
-// transport code so only the CLI pulls in CLI11's headers.
+// Command-line flags of zenoh: endpoints (CLI11). The transport itself knows
+// only the plain ZenohOptions struct.
 #include <CLI/CLI.hpp>
 
-#include "transport/zenoh/zenoh_options.hpp"
+#include "cli/transport_flags.hpp"
 
-namespace rvc::transport {
+namespace rvc::cli {
 
-void add_zenoh_options(CLI::App& app, ZenohOptions& o) {
+void add_zenoh_options(CLI::App& app, transport::ZenohOptions& o) {
   const std::string group = "Zenoh";
   app.add_option("--mode", o.mode, "Zenoh mode: peer, client or router (default peer)")
       ->check(CLI::IsMember({"peer", "client", "router"}))
@@ -36,4 +36,4 @@ void add_zenoh_options(CLI::App& app, ZenohOptions& o) {
       ->group(group);
 }
 
-}  // namespace rvc::transport
+}  // namespace rvc::cli
