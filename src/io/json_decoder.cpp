@@ -31,11 +31,24 @@ const char* expected_for(const spec::FieldTest& t) {
   return "a value";
 }
 
+// Length of a raw key: the bytes before its closing quote. A backslash
+// escapes the byte after it, so `\\"` (an escaped backslash, then the quote)
+// ends the key: looking only at the byte before a quote would read past it.
+size_t raw_key_length(const char* k) {
+  size_t n = 0;
+  while (k[n] != '"') n += k[n] == '\\' ? 2 : 1;
+  return n;
+}
+
 bool raw_has_backslash(simdjson::ondemand::raw_json_string raw) {
   const char* k = reinterpret_cast<const char*>(raw.raw());
-  for (size_t i = 0; k[i] != '"' || (i > 0 && k[i - 1] == '\\'); ++i)
-    if (k[i] == '\\') return true;
-  return false;
+  return std::memchr(k, '\\', raw_key_length(k)) != nullptr;
+}
+
+// A field's key for an error message (raw bytes, escapes shown as written).
+std::string key_text(simdjson::ondemand::field& field) {
+  const char* k = reinterpret_cast<const char*>(field.key().raw());
+  return std::string(k, raw_key_length(k));
 }
 
 // Raw JSON key == name (no escapes in name)? Keys are short: a byte loop
@@ -46,6 +59,60 @@ inline bool key_is(simdjson::ondemand::raw_json_string raw, const std::string& n
   for (size_t i = 0; i < n; ++i)
     if (k[i] != name[i]) return false;
   return k[n] == '"';
+}
+
+// Reads a value no property tests, only to check that it is well-formed:
+// simdjson's on-demand API skips unread values without validating them, and
+// a message must be rejected for malformed JSON whatever the properties read
+// (else adding a property would change another one's verdicts). Numbers are
+// read as the tested path reads them (get_double), so both agree on what a
+// number is. Returns the error, or SUCCESS.
+simdjson::error_code validate(simdjson::ondemand::value value, int depth = 0) {
+  if (depth > 1024) return simdjson::DEPTH_ERROR;  // simdjson's own default limit
+  json_type type;
+  if (auto err = value.type().get(type)) return err;
+  switch (type) {
+    case json_type::number: {
+      double d;
+      return value.get_double().get(d);
+    }
+    case json_type::string: {
+      std::string_view s;
+      return value.get_string().get(s);
+    }
+    case json_type::boolean: {
+      bool b;
+      return value.get_bool().get(b);
+    }
+    case json_type::null: {
+      bool is_null = false;
+      if (auto err = value.is_null().get(is_null)) return err;
+      return is_null ? simdjson::SUCCESS : simdjson::INCORRECT_TYPE;  // "nul", "nulx"
+    }
+    case json_type::array: {
+      simdjson::ondemand::array array;
+      if (auto err = value.get_array().get(array)) return err;
+      for (auto element : array) {
+        simdjson::ondemand::value v;
+        if (auto err = std::move(element).get(v)) return err;
+        if (auto err = validate(v, depth + 1)) return err;
+      }
+      return simdjson::SUCCESS;
+    }
+    case json_type::object: {
+      simdjson::ondemand::object object;
+      if (auto err = value.get_object().get(object)) return err;
+      for (auto field_result : object) {
+        simdjson::ondemand::field field;
+        if (auto err = std::move(field_result).get(field)) return err;
+        std::string_view key;
+        if (auto err = field.unescaped_key().get(key)) return err;
+        if (auto err = validate(field.value(), depth + 1)) return err;
+      }
+      return simdjson::SUCCESS;
+    }
+  }
+  return simdjson::INCORRECT_TYPE;
 }
 
 }  // namespace
@@ -67,8 +134,7 @@ void JsonDecoder::remember(KeyNode& node, size_t position, simdjson::ondemand::r
                            KeyNode* target) {
   // The raw key runs up to its closing quote (escaped quotes are preceded by a backslash).
   const char* k = reinterpret_cast<const char*>(raw.raw());
-  size_t n = 0;
-  while (k[n] != '"' || (n > 0 && k[n - 1] == '\\')) ++n;
+  const size_t n = raw_key_length(k);
   if (position > 64 || n > 64) return;  // odd messages: don't let the cache grow
   // A key with escapes must take the unescaping path every time.
   if (std::memchr(k, '\\', n) != nullptr) return;
@@ -194,8 +260,15 @@ bool JsonDecoder::decode_object(simdjson::ondemand::object object, KeyNode& node
       remember(node, position, raw, target);
     }
     ++position;
-    if (!target) continue;  // fields no test reads are skipped by the iterator, unparsed
     simdjson::ondemand::value value = field.value();
+    if (!target) {  // a field no test reads: only checked to be well-formed
+      if (auto err = validate(value)) {
+        error = "invalid JSON in field \"" + key_text(field) + "\": " + simdjson::error_message(err);
+        malformed_ = true;
+        return false;
+      }
+      continue;
+    }
     target->seen = generation_;
     if (target->kind != Kind::General && fast_path(*target, value)) continue;
     json_type type;
@@ -227,6 +300,16 @@ bool JsonDecoder::decode_object(simdjson::ondemand::object object, KeyNode& node
       continue;
     }
     if (!target->tests.empty() && !apply_tests(*target, value, type, error, warnings)) return false;
+    // apply_tests reads scalars of tested fields; what it did not read (a
+    // field only its children are tested on, arrays, objects, null) must
+    // still be well-formed.
+    if (target->tests.empty() || type == json_type::array || type == json_type::object || type == json_type::null) {
+      if (auto err = validate(value)) {
+        error = "invalid JSON in field \"" + target->name + "\": " + simdjson::error_message(err);
+        malformed_ = true;
+        return false;
+      }
+    }
   }
   return true;
 }

@@ -194,6 +194,11 @@ uint64_t Position::number() const {
 
 void parse_one(simdjson::ondemand::parser& parser, std::string_view text, uint64_t line, JsonlHandler& handler,
                std::string& scratch) {
+  if (text.substr(0, kUtf8Bom.size()) == kUtf8Bom) {
+    handler.on_error(LineError{line, 1, "UTF-8 byte-order mark (EF BB BF) before the message; "
+                                        "save the data as UTF-8 without BOM"});
+    return;
+  }
   // Copy into a padded buffer: simdjson reads up to SIMDJSON_PADDING bytes past the end.
   scratch.assign(text.data(), text.size());
   scratch.append(simdjson::SIMDJSON_PADDING, '\0');
@@ -259,6 +264,7 @@ bool read_jsonl(int fd, JsonlHandler& handler, const ReaderOptions& options, std
   size_t have = 0;        // bytes in buf
   uint64_t line = 1;      // line number of buf[0]
   bool skipping = false;  // inside an oversized line, dropping bytes until '\n'
+  bool at_start = true;   // nothing read yet: a byte-order mark may come first
   for (;;) {
     ssize_t n = ::read(fd, buf.data() + have, cap - have);
     if (n < 0) {
@@ -268,6 +274,16 @@ bool read_jsonl(int fd, JsonlHandler& handler, const ReaderOptions& options, std
     }
     const bool eof = n == 0;
     have += static_cast<size_t>(n);
+    if (at_start && (have >= kUtf8Bom.size() || eof)) {
+      at_start = false;
+      if (std::string_view(buf.data(), std::min(have, kUtf8Bom.size())) == kUtf8Bom) {
+        handler.on_warning(LineError{1, 1, kBomStartWarning});
+        std::memmove(buf.data(), buf.data() + kUtf8Bom.size(), have - kUtf8Bom.size());
+        have -= kUtf8Bom.size();
+      }
+    } else if (at_start) {
+      continue;  // fewer than 3 bytes so far: read on before looking
+    }
     if (skipping) {
       const char* nl = static_cast<const char*>(std::memchr(buf.data(), '\n', have));
       if (!nl && !eof) { have = 0; continue; }

@@ -64,6 +64,8 @@ class JsonlHandler {
   // The object just read (Pending) had broken text after it: forget it.
   virtual void discard() {}
   virtual void on_error(const LineError& error) = 0;
+  // Something was skipped but no message lost (a byte-order mark at the start).
+  virtual void on_warning(const LineError& warning) {}
   // The JSON error behind the last `false` from on_object.
   virtual std::string json_error() const { return "invalid JSON"; }
 };
@@ -89,6 +91,12 @@ class ChunkReader {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+// The UTF-8 byte-order mark. At the very start of a file it is skipped with a
+// warning; anywhere else (a later line, a network payload) the message is
+// rejected with an error that names it.
+inline constexpr std::string_view kUtf8Bom = "\xEF\xBB\xBF";
+inline constexpr const char* kBomStartWarning = "skipped a UTF-8 byte-order mark at the start of the input";
 
 // Parses one message (one line or one network payload) and hands it over.
 // `scratch` keeps a padded copy when the payload lacks simdjson's padding.

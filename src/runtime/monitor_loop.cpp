@@ -111,9 +111,15 @@ void MonitorLoop::process(transport::Source& source) {
           eos_ = !options_.sequence_numbers || counters_.all_ended();
           continue;
         }
-        if (options_.sequence_numbers) counters_.on_seq(f.seq, f.publisher);
-        else ++counters_.received;
-        pipeline_.feed(f.payload, f.seq ? f.seq : counters_.received);
+        std::string_view payload = f.payload;
+        if (options_.sequence_numbers) {
+          counters_.on_seq(f.seq, f.publisher);
+        } else if (++counters_.received == 1 && f.seq == 1 && payload.substr(0, io::kUtf8Bom.size()) == io::kUtf8Bom) {
+          // A file's byte-order mark, as `rvc check` treats it.
+          payload.remove_prefix(io::kUtf8Bom.size());
+          pipeline_.on_warning(io::LineError{1, 1, io::kBomStartWarning});
+        }
+        pipeline_.feed(payload, f.seq ? f.seq : counters_.received);
       }
     }
     // Counters on request or on schedule, also while no message comes.

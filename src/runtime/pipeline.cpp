@@ -50,6 +50,11 @@ void Pipeline::on_error(const io::LineError& error) {
   report(where + ": " + error.message + " (message skipped)");
 }
 
+void Pipeline::on_warning(const io::LineError& w) {
+  ++stats_.warnings;
+  report("warning: " + options_.position_name + " " + std::to_string(w.line) + ": " + w.message);
+}
+
 io::ReadResult Pipeline::on_object(const io::Position& where, simdjson::ondemand::object object) {
   std::string error;
   warnings_.clear();

@@ -46,6 +46,7 @@ class Pipeline final : public io::JsonlHandler {
   void commit() override;
   void discard() override { pending_ = false; }
   void on_error(const io::LineError& error) override;
+  void on_warning(const io::LineError& warning) override;
   // One network payload; `position` names it in errors (its sequence number).
   // A payload holding several lines is a batch: one message per line. A
   // payload (or line) over max_message_size is rejected, as in a file.

@@ -29,15 +29,10 @@ void FileSource::read_all(const FrameHandler& handler) {
   std::string buf;       // bytes read, not yet split into lines
   size_t scanned = 0;    // buf[0, scanned) holds no newline
   uint64_t line = 0;
-  bool first = true;
   auto deliver = [&](size_t begin, size_t end) {
     size_t len = end - begin;
     while (len > 0 && buf[begin + len - 1] == '\r') --len;
     ++line;
-    // A UTF-8 byte-order mark at the start of the file is not part of the
-    // message (`rvc check` skips it too).
-    if (first && len >= 3 && std::memcmp(buf.data() + begin, "\xEF\xBB\xBF", 3) == 0) begin += 3, len -= 3;
-    first = false;
     if (len > 0) handler(Frame{std::string_view(buf.data() + begin, len), line, false});  // blank lines: no message
   };
   char chunk[1 << 16];

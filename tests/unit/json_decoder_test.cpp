@@ -270,10 +270,9 @@ TEST(JsonDecoder, EscapedKeys) {
 }
 
 TEST(JsonDecoder, KeyWrittenWithUnicodeEscapeMatches) {
-  // BUG (raw-key fast path in src/io/json_decoder.cpp): {"\u0070": true}
-  // has the key "p" in JSON, but the decoder now compares raw key bytes and
-  // only unescapes when some test key itself contains a quote or backslash,
-  // so the field is silently ignored.
+  // Regression: {"\u0070": true} has the key "p" in JSON; the raw-key fast
+  // path once compared raw bytes only and ignored the field. Keys written
+  // with escapes are compared unescaped.
   Decoder d({"{p}"});
   ASSERT_TRUE(d.feed(R"({"\u0070": true})"));
   EXPECT_EQ(d["p"], 1);
@@ -293,12 +292,9 @@ TEST(JsonDecoder, ManyFieldsAndTheTestedOneLate) {
 }
 
 TEST(JsonDecoder, EmptyKeyAfterManyFields) {
-  // BUG (minor; JsonDecoder::remember in src/io/json_decoder.cpp): the
-  // per-position key cache is resized before the "position > 64" guard, so
-  // positions past 64 hold a default entry {key "", target none}. From the
-  // second message on, a field with the empty key "" at such a position
-  // matches that entry and is skipped, so {""} never changes. Fix: return
-  // before resizing when position > 64 (or store the entry).
+  // Regression: the per-position key cache was once resized before its
+  // "position > 64" guard, so positions past 64 held a default entry {key "",
+  // no target} and a field with the empty key "" there was skipped.
   std::string filler;
   for (int i = 0; i < 70; ++i) filler += "\"f" + std::to_string(i) + "\": 0, ";
   Decoder d({"{\"\"}"});

@@ -331,10 +331,9 @@ TEST(JsonlReader, TrailingContentAfterAnObjectIsOneError) {
 }
 
 TEST(JsonlReader, UnterminatedStringIsOneErrorNotACrash) {
-  // BUG (crash, SIGSEGV): parse_one's error path calls doc.current_location()
-  // on a document whose iterate() failed (here UNCLOSED_STRING), which
-  // dereferences a null parser. `rvc check` dies on such a line. Guard the
-  // location lookup with "iterate succeeded".
+  // Regression: parse_one's error path once called doc.current_location()
+  // on a document whose iterate() had failed (here UNCLOSED_STRING), which
+  // dereferenced a null parser (SIGSEGV in `rvc check`).
   Recorder r = read_file("{\"id\":1}\n{\"id\":\"abc\n{\"id\":3}\n");
   EXPECT_EQ(r.objects, (Objects{{1, 1}, {3, 3}}));
   EXPECT_EQ(r.error_lines(), (Lines{2}));
