@@ -1,6 +1,9 @@
 #include "engine/checker.hpp"
 
+#include <stdexcept>
+
 #include "spec/parser.hpp"
+#include "spec/spec_error.hpp"
 
 namespace rvc::engine {
 
@@ -12,8 +15,12 @@ void Checker::add_property(const PropertySpec& property) {
   options.dense = model_ == TimeModel::Dense;
   spec::NodePtr ast = spec::parse(property.spec, options);
   Program program = compile(*ast, atoms_, model_, property.spec);
-  if (model_ == TimeModel::Discrete) discrete_.emplace_back(program);
-  else dense_.emplace_back(program);
+  try {
+    if (model_ == TimeModel::Discrete) discrete_.emplace_back(program);
+    else dense_.emplace_back(program);
+  } catch (const std::length_error& e) {  // the monitor's size limit: a spec problem, not a runtime failure
+    throw spec::SpecError(std::string(e.what()) + "; split it into several properties", property.spec, 1);
+  }
   names_.push_back(property.name);
   last_.push_back(-1);
 }

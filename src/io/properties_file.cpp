@@ -7,9 +7,9 @@
 namespace rvc::io {
 
 std::vector<engine::PropertySpec> load_properties(const std::string& path) {
-  YAML::Node root;
+  std::vector<YAML::Node> documents;
   try {
-    root = YAML::LoadFile(path);
+    documents = YAML::LoadAllFromFile(path);
   } catch (const YAML::BadFile&) {
     throw PropertiesError(path + ": cannot open the properties file");
   } catch (const YAML::ParserException& e) {
@@ -19,16 +19,39 @@ std::vector<engine::PropertySpec> load_properties(const std::string& path) {
   auto where = [&](const YAML::Node& n) {
     return path + ":" + std::to_string(n.Mark().line + 1) + ":" + std::to_string(n.Mark().column + 1);
   };
+  // Several YAML documents (---): silently reading only the first would drop
+  // the others' properties.
+  if (documents.size() > 1)
+    throw PropertiesError(where(documents[1]) + ": a second YAML document starts here; put all properties in one "
+                                                "document (no '---' between them)");
+  if (documents.empty() || documents[0].IsNull()) throw PropertiesError(path + ": no properties defined");
+  const YAML::Node& root = documents[0];
+  auto text = [&](const YAML::Node& n, const char* what) {
+    if (!n.IsScalar()) throw PropertiesError(where(n) + ": " + what + " must be a string, not a list or a map");
+    return n.as<std::string>();
+  };
   std::vector<engine::PropertySpec> out;
-  YAML::Node list = root.IsMap() && root["properties"] ? root["properties"] : root;
+  YAML::Node list = root;
+  if (root.IsMap() && root["properties"]) {
+    for (const auto& kv : root)
+      if (kv.first.as<std::string>() != "properties")
+        throw PropertiesError(where(kv.first) + ": unknown key '" + kv.first.as<std::string>() +
+                              "' next to 'properties' (the file holds only 'properties:')");
+    list = root["properties"];
+  }
   if (list.IsSequence()) {
     for (const auto& item : list) {
       engine::PropertySpec p;
       if (item.IsScalar()) {
         p.spec = item.as<std::string>();
       } else if (item.IsMap() && item["spec"]) {
-        p.spec = item["spec"].as<std::string>();
-        if (item["name"]) p.name = item["name"].as<std::string>();
+        for (const auto& kv : item) {
+          const std::string key = kv.first.as<std::string>();
+          if (key != "name" && key != "spec")
+            throw PropertiesError(where(kv.first) + ": unknown key '" + key + "' (a property has 'name' and 'spec')");
+        }
+        p.spec = text(item["spec"], "'spec'");
+        if (item["name"]) p.name = text(item["name"], "'name'");
       } else {
         throw PropertiesError(where(item) + ": each property needs a 'spec' (and a 'name')");
       }

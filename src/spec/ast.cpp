@@ -122,18 +122,42 @@ std::string to_string(const Node& n) {
 }
 
 std::string SpecError::render(const std::string& message, const std::string& source, int column) {
+  // `column` counts characters (UTF-8 code points) from the start of the
+  // spec; find the byte where that character starts.
+  size_t at = 0;
+  for (int chars = 1; at < source.size() && chars < column; ++chars) {
+    ++at;
+    while (at < source.size() && (static_cast<unsigned char>(source[at]) & 0xC0) == 0x80) ++at;
+  }
   // Show the line holding the column (specs from files may span lines).
-  size_t at = column > 0 ? static_cast<size_t>(column - 1) : 0;
-  if (at > source.size()) at = source.size();
-  size_t line_start = source.rfind('\n', at == 0 ? 0 : at - 1);
+  size_t line_start = at == 0 ? 0 : source.rfind('\n', at - 1);
   line_start = (line_start == std::string::npos || at == 0) ? 0 : line_start + 1;
-  if (at > 0 && source[at - 1] == '\n') line_start = at;
   size_t line_end = source.find('\n', at);
   if (line_end == std::string::npos) line_end = source.size();
-  std::string line = source.substr(line_start, line_end - line_start);
-  std::string caret(at - line_start, ' ');
-  for (size_t i = 0; i < caret.size(); ++i)
-    if (line[i] == '\t') caret[i] = '\t';
+  // A long line is shown as a window around the column, cut at character
+  // boundaries, with "..." where it was cut.
+  auto char_start = [&](size_t i) {
+    while (i > 0 && i < source.size() && (static_cast<unsigned char>(source[i]) & 0xC0) == 0x80) --i;
+    return i;
+  };
+  std::string before, after;
+  if (at - line_start > 60) {
+    line_start = char_start(at - 60);
+    before = "...";
+  }
+  if (line_end - at > 60) {
+    line_end = char_start(at + 60);
+    after = "...";
+  }
+  std::string line = before + source.substr(line_start, line_end - line_start) + after;
+  // The caret line: one space per character before the column, tabs kept so
+  // it lines up under a tabbed line.
+  std::string caret(before.size(), ' ');
+  for (size_t i = line_start; i < at; ++i) {
+    unsigned char c = static_cast<unsigned char>(source[i]);
+    if ((c & 0xC0) == 0x80) continue;  // a continuation byte: same character
+    caret.push_back(c == '\t' ? '\t' : ' ');
+  }
   return "spec error at column " + std::to_string(column) + ": " + message + "\n  " + line + "\n  " + caret + "^";
 }
 

@@ -5,12 +5,23 @@
 #include <cctype>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
+#include <vector>
 
 namespace rvc::spec {
 namespace {
 
 bool is_ident_start(char c) { return std::isalpha(static_cast<unsigned char>(c)) || c == '_'; }
 bool is_ident_char(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; }
+
+// Limits that keep hostile specs from exhausting the stack (the parser, the
+// compiler and the tree's destructor all recurse over its height). Real specs
+// nest a few dozen levels; and/or chains longer than 64 terms are built as
+// balanced trees (both operators are associative), so `{a} or {b} or ...`
+// with 50,000 terms is 16 levels high, not 50,000.
+inline constexpr int kMaxNesting = 1000;
+// Discrete bounds are step counts kept in a double: integers up to 2^53 are exact.
+inline constexpr uint64_t kMaxDiscreteBound = uint64_t{1} << 53;
 
 class Parser {
  public:
@@ -35,8 +46,60 @@ class Parser {
   ParseOptions opt_;
   size_t pos_ = 0;
 
-  [[noreturn]] void fail(const std::string& message, size_t at) const {
-    throw SpecError(message, s_, static_cast<int>(at) + 1);
+  int nesting_ = 0;
+  // Byte offset -> 1-based column in characters (UTF-8 code points), so the
+  // caret sits under the right character after non-ASCII text. Cached: the
+  // parser asks mostly for increasing offsets.
+  mutable size_t col_byte_ = 0;
+  mutable int col_chars_ = 0;
+  int column(size_t at) const {
+    if (at < col_byte_) col_byte_ = 0, col_chars_ = 0;
+    for (; col_byte_ < at && col_byte_ < s_.size(); ++col_byte_)
+      if ((static_cast<unsigned char>(s_[col_byte_]) & 0xC0) != 0x80) ++col_chars_;
+    return col_chars_ + 1;
+  }
+  std::string column_text(size_t at) const { return std::to_string(column(at)); }
+
+  [[noreturn]] void fail(const std::string& message, size_t at) const { throw SpecError(message, s_, column(at)); }
+
+  // One more level of nesting (a parenthesis, a prefix operator, a
+  // quantifier, the right side of an implication) for the scope of a parse
+  // function.
+  class Nest {
+   public:
+    Nest(Parser& p, size_t at) : p_(p) {
+      if (++p_.nesting_ > kMaxNesting)
+        p_.fail("formula nested deeper than " + std::to_string(kMaxNesting) + " levels (the limit)", at);
+    }
+    ~Nest() { --p_.nesting_; }
+
+   private:
+    Parser& p_;
+  };
+
+  // A chain of one associative operator. Short chains nest to the left as
+  // written (the canonical text users see); long ones are built as balanced
+  // trees so their height stays logarithmic.
+  // `at` holds the operators' columns (taken while parsing, in order: asking
+  // for a column behind the cache would recount from the start).
+  NodePtr chain(Op op, std::vector<NodePtr>& operands, const std::vector<int>& at) {
+    if (operands.size() > 64) return balanced(op, operands, at, 0, operands.size());
+    NodePtr left = std::move(operands[0]);
+    for (size_t i = 1; i < operands.size(); ++i) {
+      auto node = make_at_column(op, at[i - 1]);
+      node->left = std::move(left);
+      node->right = std::move(operands[i]);
+      left = std::move(node);
+    }
+    return left;
+  }
+  NodePtr balanced(Op op, std::vector<NodePtr>& operands, const std::vector<int>& at, size_t lo, size_t hi) {
+    if (hi - lo == 1) return std::move(operands[lo]);
+    size_t mid = (lo + hi) / 2;
+    auto node = make_at_column(op, at[mid - 1]);  // the operator between the halves
+    node->left = balanced(op, operands, at, lo, mid);
+    node->right = balanced(op, operands, at, mid, hi);
+    return node;
   }
   bool at_end() const { return pos_ >= s_.size(); }
   char peek(size_t ahead = 0) const { return pos_ + ahead < s_.size() ? s_[pos_ + ahead] : '\0'; }
@@ -68,10 +131,11 @@ class Parser {
     pos_ += std::char_traits<char>::length(sym);
   }
 
-  static NodePtr make(Op op, size_t at) {
+  NodePtr make(Op op, size_t at) const { return make_at_column(op, column(at)); }
+  static NodePtr make_at_column(Op op, int column) {
     auto n = std::make_unique<Node>();
     n->op = op;
-    n->column = static_cast<int>(at) + 1;
+    n->column = column;
     return n;
   }
 
@@ -79,6 +143,7 @@ class Parser {
   NodePtr parse_quantified() {
     skip_ws();
     size_t at = pos_;
+    Nest nest(*this, at);
     Op op;
     if (accept_word("exists")) op = Op::Exists;
     else if (accept_word("forall")) op = Op::Forall;
@@ -103,6 +168,7 @@ class Parser {
     skip_ws();
     size_t at = pos_;
     if (accept_symbol("->") || accept_word("implies")) {
+      Nest nest(*this, at);
       auto node = make(Op::Implies, at);
       node->left = std::move(left);
       node->right = parse_implication();  // right-associative
@@ -112,29 +178,31 @@ class Parser {
   }
 
   NodePtr parse_disjunction() {
-    NodePtr left = parse_conjunction();
+    std::vector<NodePtr> operands;
+    std::vector<int> ops;
+    operands.push_back(parse_conjunction());
     for (;;) {
       skip_ws();
       size_t at = pos_;
-      if (!(accept_symbol("||") || accept_word("or"))) return left;
-      auto node = make(Op::Or, at);
-      node->left = std::move(left);
-      node->right = parse_conjunction();
-      left = std::move(node);
+      if (!(accept_symbol("||") || accept_word("or"))) break;
+      ops.push_back(column(at));
+      operands.push_back(parse_conjunction());
     }
+    return chain(Op::Or, operands, ops);
   }
 
   NodePtr parse_conjunction() {
-    NodePtr left = parse_since();
+    std::vector<NodePtr> operands;
+    std::vector<int> ops;
+    operands.push_back(parse_since());
     for (;;) {
       skip_ws();
       size_t at = pos_;
-      if (!(accept_symbol("&&") || accept_word("and"))) return left;
-      auto node = make(Op::And, at);
-      node->left = std::move(left);
-      node->right = parse_since();
-      left = std::move(node);
+      if (!(accept_symbol("&&") || accept_word("and"))) break;
+      ops.push_back(column(at));
+      operands.push_back(parse_since());
     }
+    return chain(Op::And, operands, ops);
   }
 
   NodePtr parse_since() {
@@ -158,6 +226,7 @@ class Parser {
     else if (accept_word("once") || accept_word("P")) op = Op::Once;
     else if (accept_word("historically") || accept_word("H")) op = Op::Historically;
     else return parse_primary();
+    Nest nest(*this, at);
     auto node = make(op, at);
     if (op != Op::Not) node->bounds = parse_bounds_opt(at);
     if (op == Op::Pre && node->bounds.explicit_bounds)
@@ -178,8 +247,8 @@ class Parser {
       if (peek() != ')') {
         if (peek_word("since") || peek_word("S"))
           fail("chained 'since' is ambiguous: add parentheses, e.g. (a since b) since c", pos_);
-        fail(at_end() ? "missing ')' to close the '(' at column " + std::to_string(at + 1)
-                      : "expected ')' to close the '(' at column " + std::to_string(at + 1),
+        fail(at_end() ? "missing ')' to close the '(' at column " + column_text(at)
+                      : "expected ')' to close the '(' at column " + column_text(at),
              pos_);
       }
       ++pos_;
@@ -214,7 +283,7 @@ class Parser {
     skip_ws();
     if (peek() != ']') b.hi = parse_bound_number();
     skip_ws();
-    if (peek() != ']') fail("expected ']' to close the time bounds opened at column " + std::to_string(open + 1), pos_);
+    if (peek() != ']') fail("expected ']' to close the time bounds opened at column " + column_text(open), pos_);
     ++pos_;
     if (b.hi < b.lo) fail("empty time interval: the lower bound is greater than the upper bound", open);
     return b;
@@ -224,10 +293,29 @@ class Parser {
     skip_ws();
     size_t at = pos_;
     if (peek() == '-') fail("time bounds must not be negative", at);
+    if (!opt_.dense) {
+      // Discrete bounds count steps: read them as integers, never through a
+      // double that would round or saturate a huge bound silently.
+      size_t end = pos_;
+      while (end < s_.size() && std::isdigit(static_cast<unsigned char>(s_[end]))) ++end;
+      const bool fraction = end < s_.size() && (s_[end] == '.' || s_[end] == 'e' || s_[end] == 'E');
+      if (end > pos_ && !fraction) {
+        uint64_t v = 0;
+        auto [ptr, ec] = std::from_chars(s_.data() + pos_, s_.data() + end, v);
+        if (ec == std::errc::result_out_of_range || (ec == std::errc() && v > kMaxDiscreteBound))
+          fail("time bound " + s_.substr(pos_, end - pos_) + " is too large: discrete bounds go up to " +
+                   std::to_string(kMaxDiscreteBound) + " steps",
+               at);
+        pos_ = end;
+        return static_cast<double>(v);
+      }
+    }
     double v = parse_number_token("a time bound");
     if (!opt_.dense && v != std::floor(v))
       fail("discrete time needs integer bounds (use --dense for real-valued bounds)", at);
-    if (std::isinf(v) || std::isnan(v)) fail("time bound out of range", at);
+    if (!opt_.dense && v > static_cast<double>(kMaxDiscreteBound))
+      fail("time bound is too large: discrete bounds go up to " + std::to_string(kMaxDiscreteBound) + " steps", at);
+    if (std::isinf(v) || std::isnan(v)) fail("time bound out of range (not a finite number)", at);
     return v;
   }
 
@@ -242,6 +330,8 @@ class Parser {
     double v = 0;
     const char* first = s_.data() + pos_ + (s_[pos_] == '+' ? 1 : 0);
     auto [ptr, ec] = std::from_chars(first, s_.data() + end, v);
+    if (ec == std::errc::result_out_of_range && ptr == s_.data() + end)
+      fail(std::string("the number for ") + what + " is out of range (not a finite number)", at);
     if (ec != std::errc() || ptr != s_.data() + end || end == at)
       fail(std::string("expected a number for ") + what, at);
     pos_ = end;
@@ -251,24 +341,20 @@ class Parser {
   // braces := '{' test (',' test)* '}'  — a conjunction of field tests
   NodePtr parse_braces() {
     size_t open = pos_++;
-    NodePtr result;
+    std::vector<NodePtr> tests;
+    std::vector<int> ands;  // every conjunction of a braces group sits at its '{'
+    const int open_column = column(open);
     for (;;) {
       auto leaf = make(Op::Test, pos_);
       leaf->test = parse_field_test();
       leaf->column = leaf->test.column;
-      if (!result) {
-        result = std::move(leaf);
-      } else {
-        auto conj = make(Op::And, open);
-        conj->left = std::move(result);
-        conj->right = std::move(leaf);
-        result = std::move(conj);
-      }
+      if (!tests.empty()) ands.push_back(open_column);
+      tests.push_back(std::move(leaf));
       skip_ws();
       if (peek() == ',') { ++pos_; continue; }
-      if (peek() == '}') { ++pos_; return result; }
-      if (at_end()) fail("missing '}' to close the atom opened at column " + std::to_string(open + 1), pos_);
-      fail("expected ',' or '}' in the atom opened at column " + std::to_string(open + 1), pos_);
+      if (peek() == '}') { ++pos_; return chain(Op::And, tests, ands); }
+      if (at_end()) fail("missing '}' to close the atom opened at column " + column_text(open), pos_);
+      fail("expected ',' or '}' in the atom opened at column " + column_text(open), pos_);
     }
   }
 
@@ -291,7 +377,7 @@ class Parser {
       if (peek() == '\\' && pos_ + 1 < s_.size()) ++pos_;
       out.push_back(s_[pos_++]);
     }
-    if (at_end()) fail("unterminated string started at column " + std::to_string(open + 1), open);
+    if (at_end()) fail("unterminated string started at column " + column_text(open), open);
     ++pos_;
     return out;
   }
@@ -299,7 +385,7 @@ class Parser {
   FieldTest parse_field_test() {
     FieldTest t;
     skip_ws();
-    t.column = static_cast<int>(pos_) + 1;
+    t.column = column(pos_);
     t.path.push_back(parse_key_segment());
     while (peek() == '.') {  // nested field: {pose.position.x > 1}
       ++pos_;

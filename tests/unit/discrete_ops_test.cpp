@@ -3,6 +3,8 @@
 // out by hand from the definitions; comments give the reasoning.
 #include <gtest/gtest.h>
 
+#include "spec/spec_error.hpp"
+
 #include <vector>
 
 #include "engine/discrete/historically.hpp"
@@ -156,8 +158,10 @@ TEST(DiscreteOnce, ThroughMonitorWithBounds) {
   EXPECT_EQ(run_discrete("once[2:4] {p}", {{"p", {0, 1, 0, 0, 0, 0, 0, 0}}}), (V{0, 0, 0, 1, 1, 1, 0, 0}));
   EXPECT_EQ(run_discrete("once[:0] {p}", {{"p", {1, 0, 1}}}), (V{1, 0, 1}));
   EXPECT_EQ(run_discrete("P[3:] {p}", {{"p", {1, 0, 0, 0, 0}}}), (V{0, 0, 0, 1, 1}));
-  // A bound larger than any step count is as good as none.
-  EXPECT_EQ(run_discrete("once[:1e30] {p}", {{"p", {0, 1, 0}}}), (V{0, 1, 1}));
+  // A bound larger than any step count is as good as none; one that does not
+  // fit the engine is refused (it used to be clamped silently).
+  EXPECT_EQ(run_discrete("once[:9007199254740992] {p}", {{"p", {0, 1, 0}}}), (V{0, 1, 1}));
+  EXPECT_THROW(run_discrete("once[:1e30] {p}", {{"p", {0}}}), spec::SpecError);
 }
 
 // once[:1000] over 5000 steps: with a zero lower bound two live windows

@@ -110,3 +110,37 @@ TEST(PropertiesFile, Errors) {
 
 }  // namespace
 }  // namespace rvc::io
+
+namespace rvc::io {
+namespace {
+
+std::string load_error(const std::string& yaml) {
+  test::TempFile f(yaml);
+  try {
+    load_properties(f.path());
+    return "";
+  } catch (const PropertiesError& e) {
+    return e.what();
+  }
+}
+
+TEST(PropertiesFileHostile, UnknownKeysAreNamedWithTheirPosition) {
+  std::string e = load_error("properties:\n  - name: x\n    sepc: '{p}'\n    spec: '{q}'\n");
+  EXPECT_NE(e.find(":3:5: unknown key 'sepc' (a property has 'name' and 'spec')"), std::string::npos) << e;
+  e = load_error("properties:\n  - name: x\n    spec: '{q}'\nversion: 2\n");
+  EXPECT_NE(e.find(":4:1: unknown key 'version' next to 'properties'"), std::string::npos) << e;
+}
+
+TEST(PropertiesFileHostile, SecondDocumentIsRefusedNotDropped) {
+  std::string e = load_error("a: '{p}'\n---\nb: '{q}'\n");
+  EXPECT_NE(e.find(":3:1: a second YAML document starts here"), std::string::npos) << e;
+}
+
+TEST(PropertiesFileHostile, SpecMustBeAString) {
+  std::string e = load_error("properties:\n  - name: x\n    spec: ['{p}', '{q}']\n");
+  EXPECT_NE(e.find(":3:11: 'spec' must be a string"), std::string::npos) << e;
+  EXPECT_NE(load_error("").find("no properties defined"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace rvc::io
