@@ -46,8 +46,9 @@ bool raw_has_backslash(simdjson::ondemand::raw_json_string raw) {
 }
 
 // A field's key for an error message (raw bytes, escapes shown as written).
-std::string key_text(simdjson::ondemand::field& field) {
-  const char* k = reinterpret_cast<const char*>(field.key().raw());
+// (Take the raw key before unescaped_key(): that one consumes it.)
+std::string key_text(simdjson::ondemand::raw_json_string raw) {
+  const char* k = reinterpret_cast<const char*>(raw.raw());
   return std::string(k, raw_key_length(k));
 }
 
@@ -263,7 +264,7 @@ bool JsonDecoder::decode_object(simdjson::ondemand::object object, KeyNode& node
     simdjson::ondemand::value value = field.value();
     if (!target) {  // a field no test reads: only checked to be well-formed
       if (auto err = validate(value)) {
-        error = "invalid JSON in field \"" + key_text(field) + "\": " + simdjson::error_message(err);
+        error = "invalid JSON in field \"" + key_text(raw) + "\": " + simdjson::error_message(err);
         malformed_ = true;
         return false;
       }

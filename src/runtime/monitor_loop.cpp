@@ -114,11 +114,14 @@ void MonitorLoop::process(transport::Source& source) {
         std::string_view payload = f.payload;
         if (options_.sequence_numbers) {
           counters_.on_seq(f.seq, f.publisher);
-        } else if (++counters_.received == 1 && f.seq == 1 && payload.substr(0, io::kUtf8Bom.size()) == io::kUtf8Bom) {
-          // A file's byte-order mark, as `rvc check` treats it.
+        } else if (f.seq == 1 && payload.substr(0, io::kUtf8Bom.size()) == io::kUtf8Bom) {
+          // A file's byte-order mark, as `rvc check` treats it; on a line of
+          // its own it leaves a blank line, which is no message.
           payload.remove_prefix(io::kUtf8Bom.size());
           pipeline_.on_warning(io::LineError{1, 1, io::kBomStartWarning});
+          if (payload.find_first_not_of(" \t\r") == std::string_view::npos) continue;
         }
+        if (!options_.sequence_numbers) ++counters_.received;
         pipeline_.feed(payload, f.seq ? f.seq : counters_.received);
       }
     }

@@ -63,12 +63,10 @@ io::ReadResult Pipeline::on_object(const io::Position& where, simdjson::ondemand
       json_error_ = error;
       return io::ReadResult::Malformed;
     }
-    on_error(io::LineError{where.number(), 0, error});
-    return io::ReadResult::Rejected;
-  }
-  for (const std::string& w : warnings_) {
-    ++stats_.warnings;
-    report("warning: " + options_.position_name + " " + std::to_string(where.number()) + ": " + w);
+    // Valid JSON the properties cannot use. Reported at commit(), once the
+    // reader knows the object is alone on its line: if text follows it, the
+    // whole line is one bad message, reported once (found by fuzz_jsonl).
+    pending_rejection_ = error;
   }
   pending_ = true;
   pending_where_.emplace(where);
@@ -78,6 +76,15 @@ io::ReadResult Pipeline::on_object(const io::Position& where, simdjson::ondemand
 void Pipeline::commit() {
   if (!pending_) return;
   pending_ = false;
+  if (!pending_rejection_.empty()) {
+    on_error(io::LineError{pending_where_->number(), 0, pending_rejection_});
+    pending_rejection_.clear();
+    return;
+  }
+  for (const std::string& w : warnings_) {
+    ++stats_.warnings;
+    report("warning: " + options_.position_name + " " + std::to_string(pending_where_->number()) + ": " + w);
+  }
   if (options_.parse_only) {
     decoder_.commit();
   } else if (checker_.model() == engine::TimeModel::Discrete) {

@@ -44,7 +44,10 @@ class Pipeline final : public io::JsonlHandler {
   io::ReadResult on_object(const io::Position& position, simdjson::ondemand::object object) override;
   std::string json_error() const override { return json_error_; }
   void commit() override;
-  void discard() override { pending_ = false; }
+  void discard() override {
+    pending_ = false;
+    pending_rejection_.clear();
+  }
   void on_error(const io::LineError& error) override;
   void on_warning(const io::LineError& warning) override;
   // One network payload; `position` names it in errors (its sequence number).
@@ -71,7 +74,8 @@ class Pipeline final : public io::JsonlHandler {
   std::optional<io::Position> pending_where_;
   double last_time_ = 0;
   uint64_t reported_ = 0;
-  std::vector<std::string> warnings_;
+  std::vector<std::string> warnings_;  // of the pending message, reported at commit()
+  std::string pending_rejection_;      // why the pending message is refused, reported at commit()
   std::string json_error_;
   simdjson::ondemand::parser parser_;
   std::string scratch_;

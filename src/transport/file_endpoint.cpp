@@ -33,7 +33,10 @@ void FileSource::read_all(const FrameHandler& handler) {
     size_t len = end - begin;
     while (len > 0 && buf[begin + len - 1] == '\r') --len;
     ++line;
-    if (len > 0) handler(Frame{std::string_view(buf.data() + begin, len), line, false});  // blank lines: no message
+    // Blank lines (nothing, or only spaces, tabs and CRs) are not messages,
+    // as in `rvc check`.
+    std::string_view text(buf.data() + begin, len);
+    if (text.find_first_not_of(" \t\r") != std::string_view::npos) handler(Frame{text, line, false});
   };
   char chunk[1 << 16];
   for (;;) {

@@ -23,9 +23,9 @@ struct Result {
 
 // Runs `lines` through the chunked file reader (or, with `payloads`, one
 // network payload per line, as `rvc monitor` feeds them).
-Result run(const std::vector<engine::PropertySpec>& props, const std::string& content, bool payloads = false) {
+Result run(const std::vector<engine::PropertySpec>& props, const std::string& content, bool payloads = false,
+           PipelineOptions o = {}, size_t chunk = 256) {
   Result r;
-  PipelineOptions o;
   o.emit_all = true;
   testing::internal::CaptureStderr();
   {
@@ -46,7 +46,8 @@ Result run(const std::vector<engine::PropertySpec>& props, const std::string& co
       int fd = ::open(f.path().c_str(), O_RDONLY);
       std::string error;
       io::ReaderOptions ro;
-      ro.chunk_bytes = 256;  // many chunks: the fast path and its fallback both run
+      ro.chunk_bytes = chunk;  // many chunks: the fast path and its fallback both run
+      ro.max_line_bytes = o.max_message_size;
       EXPECT_TRUE(io::read_jsonl(fd, p, ro, error)) << error;
       ::close(fd);
     }
@@ -92,6 +93,18 @@ TEST(JsonHostile, ByteOrderMarkAtTheStartIsSkippedWithAWarning) {
   Result p = run(kAlone, "\xEF\xBB\xBF{\"x\":1}\n", true);  // a network payload: an error naming it
   EXPECT_EQ(p.stats.rejected, 1u);
   EXPECT_NE(p.stderr_text.find("byte-order mark"), std::string::npos) << p.stderr_text;
+}
+
+// Found by fuzz_jsonl: small chunks and a small size limit; the file reader
+// and one payload per line must accept and reject the same messages.
+TEST(JsonHostile, FuzzFoundChunkedReaderCase) {
+  const std::string content = std::string("\n{\"x\":1} {\"x\":2}\0{\"x\":\n{\" {\"x\":2}\0{\"x\":\n{\"x\":2tr}", 50);
+  PipelineOptions o;
+  o.model = engine::TimeModel::Dense;
+  o.max_message_size = 24;
+  Result file = run(kAlone, content, false, o, 16), payloads = run(kAlone, content, true, o);
+  EXPECT_EQ(file.stats.accepted, payloads.stats.accepted);
+  EXPECT_EQ(file.stats.rejected, payloads.stats.rejected) << file.stderr_text << "\n---\n" << payloads.stderr_text;
 }
 
 // Random messages, some malformed in tested or untested fields: property a's
