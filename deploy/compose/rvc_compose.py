@@ -275,7 +275,7 @@ class Deployment:
             err = ipvlan_supported(parent)
             if err:
                 self.remove_links()
-                raise Unsupported("ipvlan: this kernel cannot create ipvlan links (%s); mode skipped" % err)
+                raise Unsupported("[platform] ipvlan: this kernel cannot create ipvlan links (%s); mode skipped" % err)
 
     def remove_links(self):
         for name in self.links:
@@ -448,14 +448,14 @@ def mode_support():
         r = subprocess.run(root_cmd(["ip", "link", "add", name, "type", "veth", "peer", "name", name + "p"]),
                            capture_output=True, text=True)
         if r.returncode != 0:
-            res["macvlan"] = res["ipvlan"] = "cannot create a veth pair: " + r.stderr.strip()
+            res["macvlan"] = res["ipvlan"] = "[platform] cannot create a veth pair: " + r.stderr.strip()
             return res
         subprocess.run(root_cmd(["ip", "link", "set", name, "up"]), capture_output=True)
         for kind in ("macvlan", "ipvlan"):
             r = subprocess.run(root_cmd(["ip", "link", "add", name + "t", "link", name, "type", kind]),
                                capture_output=True, text=True)
             if r.returncode != 0:
-                res[kind] = "the kernel cannot create %s links (%s)" % (kind, r.stderr.strip())
+                res[kind] = "[platform] the kernel cannot create %s links (%s)" % (kind, r.stderr.strip())
             else:
                 subprocess.run(root_cmd(["ip", "link", "del", name + "t"]), capture_output=True)
     finally:

@@ -1,37 +1,7 @@
 import os
-import shutil
-import pytest
+import sys
 
-
-def rvc_binary():
-    path = os.environ.get("RVC_BIN")
-    if path:
-        return path
-    root = os.path.dirname(os.path.abspath(__file__))
-    while root != "/" and not os.path.exists(os.path.join(root, "CMakePresets.json")):
-        root = os.path.dirname(root)
-    for preset in ("release", "core", "debug"):
-        candidate = os.path.join(root, "build", preset, "rvc")
-        if os.path.exists(candidate):
-            return os.path.abspath(candidate)
-    found = shutil.which("rvc")
-    if found:
-        return found
-    pytest.exit("rvc binary not found: build first or set RVC_BIN", returncode=2)
-
-
-@pytest.fixture(scope="session")
-def rvc():
-    return rvc_binary()
-
-
-def transports_built(rvc):
-    """Transports compiled into this rvc (from `rvc monitor --help`)."""
-    import subprocess
-    out = subprocess.run([rvc, "monitor", "--help"], capture_output=True, text=True).stdout
-    found = []
-    if "--domain" in out:
-        found.append("dds")
-    if "--connect" in out:
-        found.append("zenoh")
-    return found
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "../.."))
+# fixtures (rvc) and hooks (skips fail under CI=true) shared by every pytest tier
+from rvc_testlib import (BY_DESIGN, PLATFORM, pytest_make_collect_report, pytest_runtest_makereport,  # noqa: E402,F401
+                         rvc, rvc_binary, transports_built)
