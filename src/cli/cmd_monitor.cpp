@@ -12,6 +12,7 @@
 #include "cli/commands.hpp"
 #include "cli/transport_flags.hpp"
 #include "cli/signals.hpp"
+#include "msg/type_registry.hpp"
 #include "runtime/monitor_loop.hpp"
 #include "transport/transport_options.hpp"
 
@@ -30,6 +31,9 @@ struct MonitorCommand {
   size_t queue_capacity = 1 << 14;
   size_t wait_subscribers = 0;  // per network output, before subscribing to the input
   double wait_timeout = 10;
+  std::string type;                    // --type: payloads are CDR samples of this ROS 2 type
+  std::vector<std::string> msg_paths;  // --msg-path
+  msg::TypeRegistry registry;          // owns the type the pipeline decodes
 
   // An output that the input would read back (the same file, an
   // intersecting key expression, the same topic) feeds the monitor its own
@@ -70,6 +74,16 @@ struct MonitorCommand {
     runtime::VerdictOutputs verdicts(std::move(sinks), !check.dense);
     runtime::PipelineOptions popts = check.pipeline_options();
     popts.position_name = "seq";
+    if (!type.empty()) {
+      const std::string scheme = transport::scheme_of(input);
+      if (scheme != "zenoh") {
+        std::fprintf(stderr, "rvc: --type reads CDR payloads from a zenoh: input (as zenoh-bridge-ros2dds forwards "
+                             "them); %s inputs carry JSON\n", scheme.c_str());
+        return kUsage;
+      }
+      for (const auto& p : msg_paths) registry.add_search_path(p);
+      popts.type = &registry.resolve(type);
+    }
     runtime::Pipeline pipeline(properties, popts, [&](const engine::Verdict& v) { verdicts.put(v); });
 
     runtime::LoopOptions lopts;
@@ -114,6 +128,10 @@ Runner register_monitor(CLI::App& app) {
                   "Before reading the input, wait for this many subscribers on each zenoh:/dds: output")
       ->capture_default_str();
   sub->add_option("--wait-timeout", cmd->wait_timeout, "Seconds to wait for them")->capture_default_str();
+  sub->add_option("--type", cmd->type,
+                  "ROS 2 message type of the input's CDR payloads, pkg/msg/Name (`rvc msg list`, `rvc msg show`)");
+  sub->add_option("--msg-path", cmd->msg_paths,
+                  "Folder of .msg definitions for --type: a ROS 2 share/ tree or a plain folder (repeatable)");
   sub->add_option("--queue", cmd->queue_capacity, "Messages buffered between transport and engine")->capture_default_str();
   add_transport_options(*sub, cmd->transports);
   sub->footer(

@@ -24,5 +24,6 @@ Runner register_router(CLI::App& app);      // only with the Zenoh transport
 Runner register_dds_config(CLI::App& app);  // only with the DDS transport
 Runner register_perf(CLI::App& app);
 Runner register_bridge(CLI::App& app);
+Runner register_msg(CLI::App& app);         // ROS 2 message types, CDR <-> JSON
 
 }  // namespace rvc::cli

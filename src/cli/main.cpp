@@ -7,6 +7,7 @@
 #include <map>
 
 #include "cli/commands.hpp"
+#include "msg/msg_types.hpp"
 #include "io/properties_file.hpp"
 #include "spec/spec_error.hpp"
 
@@ -38,6 +39,7 @@ int main(int argc, char** argv) {
   runners["replay"] = register_replay(app);
   runners["perf"] = register_perf(app);
   runners["bridge"] = register_bridge(app);
+  runners["msg"] = register_msg(app);
 #ifdef RVC_HAVE_ZENOH
   runners["router"] = register_router(app);
 #endif
@@ -55,6 +57,9 @@ int main(int argc, char** argv) {
       return runners.at(sub->get_name())();
     }
   } catch (const rvc::spec::SpecError& e) {
+    std::fprintf(stderr, "rvc: %s\n", e.what());
+    return kUsage;
+  } catch (const rvc::msg::MsgError& e) {
     std::fprintf(stderr, "rvc: %s\n", e.what());
     return kUsage;
   } catch (const rvc::io::PropertiesError& e) {

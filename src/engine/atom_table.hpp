@@ -19,6 +19,9 @@ class AtomTable {
     return it->second;
   }
   const std::vector<spec::FieldTest>& tests() const { return tests_; }
+  // Replaces a test's value once its meaning is known (a message constant
+  // named by a bare word becomes its number), before any message is decoded.
+  void set_value(int id, const spec::Literal& value) { tests_[static_cast<size_t>(id)].value = value; }
   size_t size() const { return tests_.size(); }
 
  private:

@@ -2,7 +2,9 @@
 
 #include <cstdio>
 
+#include "io/cdr_codec.hpp"
 #include "io/verdict_writer.hpp"
+#include "runtime/typed_specs.hpp"
 #include "spec/spec_error.hpp"
 
 namespace rvc::runtime {
@@ -18,6 +20,9 @@ engine::Checker build(const std::vector<engine::PropertySpec>& properties, const
       throw spec::SpecError("in property '" + p.name + "': " + e.message(), e.source(), e.column());
     }
   }
+  if (options.type)
+    bind_message_type(checker, properties, *options.type, options.model == engine::TimeModel::Dense,
+                      options.time_field);
   return checker;
 }
 
@@ -109,7 +114,27 @@ void Pipeline::commit() {
   ++stats_.accepted;
 }
 
+bool Pipeline::oversized(std::string_view payload, uint64_t position) {
+  if (payload.size() <= options_.max_message_size) return false;
+  // Worded as the file reader words it: check and monitor report alike.
+  on_error(io::LineError{position, 0,
+                         "message longer than " + std::to_string(options_.max_message_size) +
+                             " bytes (--max-message-size); skipped"});
+  return true;
+}
+
 void Pipeline::feed(std::string_view payload, uint64_t position) {
+  if (options_.type) {  // one CDR sample per payload (never a batch)
+    if (oversized(payload, position)) return;
+    typed_json_.clear();
+    io::CdrError error;
+    if (!io::cdr_to_json(*options_.type, payload, typed_json_, error)) {
+      on_error(io::LineError{position, 0, "bad " + options_.type->full_name() + " sample: " + error.to_string()});
+      return;
+    }
+    io::parse_one(parser_, typed_json_, position, *this, scratch_);
+    return;
+  }
   if (payload.find('\n') != std::string_view::npos) {
     // A batch: the reader applies the size limit to each line.
     batch_position_ = position;
@@ -117,13 +142,7 @@ void Pipeline::feed(std::string_view payload, uint64_t position) {
     batch_position_ = 0;
     return;
   }
-  if (payload.size() > options_.max_message_size) {
-    // Worded as the file reader words it: check and monitor report alike.
-    on_error(io::LineError{position, 0,
-                           "message longer than " + std::to_string(options_.max_message_size) +
-                               " bytes (--max-message-size); skipped"});
-    return;
-  }
+  if (oversized(payload, position)) return;
   io::parse_one(parser_, payload, position, *this, scratch_);
 }
 

@@ -15,6 +15,7 @@
 #include "engine/checker.hpp"
 #include "io/json_decoder.hpp"
 #include "io/jsonl_reader.hpp"
+#include "msg/msg_types.hpp"
 
 namespace rvc::runtime {
 
@@ -27,6 +28,10 @@ struct PipelineOptions {
   size_t max_reported = 100;           // errors and warnings printed before going quiet
   bool parse_only = false;             // decode every message but run no monitor (benchmark floor)
   size_t max_message_size = 1 << 20;   // longest message: a line, a payload, a line inside a batched payload
+  // Typed input (--type): each payload is one CDR sample of this type, decoded
+  // to JSON before the usual path (properties are checked against the type
+  // first). Owned by the caller's msg::TypeRegistry; null: JSON payloads.
+  const msg::MessageType* type = nullptr;
 };
 
 struct PipelineStats {
@@ -63,6 +68,7 @@ class Pipeline final : public io::JsonlHandler {
 
  private:
   void report(const std::string& text);
+  bool oversized(std::string_view payload, uint64_t position);  // rejects it if so
   engine::Checker checker_;
   PipelineOptions options_;
   io::JsonDecoder decoder_;
@@ -79,6 +85,7 @@ class Pipeline final : public io::JsonlHandler {
   std::string json_error_;
   simdjson::ondemand::parser parser_;
   std::string scratch_;
+  std::string typed_json_;  // a CDR sample decoded to JSON
   io::ChunkReader batch_reader_;
   uint64_t batch_position_ = 0;  // position of the payload being read as a batch, else 0
 };

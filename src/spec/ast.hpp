@@ -27,6 +27,7 @@ struct Literal {
   bool b = false;
   double number = 0;
   std::string text;
+  bool bare_word = false;  // a String written without quotes ({gear: REVERSE}): may name a message constant
 };
 
 // One test on one field: {p}, {p: false}, {x > 3}, {mode: "a"}, {m: *}, {id: *x}.

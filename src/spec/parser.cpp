@@ -451,6 +451,7 @@ class Parser {
       } else if (allow_bare_word) {  // Reelay reads {mode: sport} as the string "sport"
         lit.kind = Literal::Kind::String;
         lit.text = word;
+        lit.bare_word = true;
       }
     } else {
       fail(at_end() ? "unexpected end of specification: expected a value" : "expected a value (number, true, false or string)", at);

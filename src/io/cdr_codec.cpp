@@ -1,0 +1,438 @@
+#include "io/cdr_codec.hpp"
+
+#include <simdjson.h>
+
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+#include "io/json_writer.hpp"
+
+namespace rvc::io {
+
+using msg::ArrayKind;
+using msg::Field;
+using msg::FieldType;
+using msg::MessageType;
+using msg::Prim;
+
+namespace {
+
+constexpr size_t kHeader = 4;
+
+template <typename T>
+T byteswap(T v) {
+  unsigned char b[sizeof(T)];
+  std::memcpy(b, &v, sizeof(T));
+  for (size_t i = 0; i < sizeof(T) / 2; ++i) std::swap(b[i], b[sizeof(T) - 1 - i]);
+  std::memcpy(&v, b, sizeof(T));
+  return v;
+}
+
+constexpr bool kHostLittle = __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__;
+
+// Floats as the JSON writer prints them, but -0.0 keeps its sign: a sample
+// decoded and encoded again must give back the same bytes.
+void append_float(std::string& out, double v) {
+  if (v == 0 && std::signbit(v)) out += "-0.0";
+  else append_number(out, v);
+}
+
+// ------------------------------------------------------------------ decoding
+
+class Reader {
+ public:
+  Reader(std::string_view sample, bool little, std::string& out, CdrError& error)
+      : data_(reinterpret_cast<const unsigned char*>(sample.data()) + kHeader),
+        size_(sample.size() - kHeader), swap_(little != kHostLittle), out_(out), error_(error) {}
+
+  bool message(const MessageType& type) {
+    if (type.fields.empty()) {  // an empty message is one uint8 on the wire
+      uint8_t ignored;
+      if (!read(ignored)) return false;
+      out_ += "{}";
+      return true;
+    }
+    out_ += '{';
+    bool first = true;
+    for (const Field& f : type.fields) {
+      size_t path_size = path_.size();
+      if (!path_.empty()) path_ += '.';
+      path_ += f.name;
+      if (!first) out_ += ',';
+      first = false;
+      append_json_string(out_, f.name);
+      out_ += ':';
+      if (!field(f.type)) return false;
+      path_.resize(path_size);
+    }
+    out_ += '}';
+    return true;
+  }
+
+  // After the last field: only padding (at most 3 bytes, to a 4-byte boundary) may remain.
+  bool finish() {
+    size_t rest = size_ - pos_;
+    if (rest > 3) {
+      error_ = {std::to_string(rest) + " bytes left over after the last field (a sample of another type?)",
+                pos_ + kHeader};
+      return false;
+    }
+    return true;
+  }
+
+ private:
+  bool fail(const std::string& what) {
+    error_ = {what + (path_.empty() ? std::string() : " in field " + path_), pos_ + kHeader};
+    return false;
+  }
+
+  bool align(size_t n) {
+    size_t p = (pos_ + n - 1) & ~(n - 1);
+    if (p > size_) return fail("truncated sample");
+    pos_ = p;
+    return true;
+  }
+
+  template <typename T>
+  bool read(T& v) {
+    if (!align(sizeof(T))) return false;
+    if (size_ - pos_ < sizeof(T)) return fail("truncated sample");
+    std::memcpy(&v, data_ + pos_, sizeof(T));
+    if (swap_ && sizeof(T) > 1) v = byteswap(v);
+    pos_ += sizeof(T);
+    return true;
+  }
+
+  bool count(uint32_t& n, size_t min_element_size) {
+    if (!read(n)) return false;
+    // every element takes at least min_element_size bytes: a count the rest
+    // of the sample cannot hold is refused before any element is read
+    if (min_element_size && n > (size_ - pos_) / min_element_size) {
+      pos_ -= 4;
+      return fail("sequence length " + std::to_string(n) + " exceeds the sample");
+    }
+    return true;
+  }
+
+  bool string_value(uint32_t bound) {
+    uint32_t len;
+    if (!count(len, 1)) return false;
+    if (len == 0) {  // some writers send an empty string as length 0, without the NUL
+      out_ += "\"\"";
+      return true;
+    }
+    const char* s = reinterpret_cast<const char*>(data_ + pos_);
+    if (s[len - 1] != '\0') return fail("string without its terminating NUL");
+    std::string_view text(s, len - 1);
+    if (text.find('\0') != std::string_view::npos) return fail("string with a NUL inside");
+    if (bound && text.size() > bound)
+      return fail("string of " + std::to_string(text.size()) + " bytes over its bound " + std::to_string(bound));
+    if (!simdjson::validate_utf8(text.data(), text.size())) return fail("string that is not UTF-8");
+    append_json_string(out_, text);
+    pos_ += len;
+    return true;
+  }
+
+  template <typename T>
+  bool integer() {
+    T v;
+    if (!read(v)) return false;
+    if constexpr (std::is_signed_v<T>) out_ += std::to_string(static_cast<int64_t>(v));
+    else out_ += std::to_string(static_cast<uint64_t>(v));
+    return true;
+  }
+
+  bool scalar(const FieldType& t) {
+    switch (t.prim) {
+      case Prim::Bool: {
+        uint8_t v;
+        if (!read(v)) return false;
+        if (v > 1) {
+          pos_ -= 1;
+          return fail("bool holding " + std::to_string(v));
+        }
+        out_ += v ? "true" : "false";
+        return true;
+      }
+      case Prim::Byte: case Prim::Char: case Prim::UInt8: return integer<uint8_t>();
+      case Prim::Int8: return integer<int8_t>();
+      case Prim::Int16: return integer<int16_t>();
+      case Prim::UInt16: return integer<uint16_t>();
+      case Prim::Int32: return integer<int32_t>();
+      case Prim::UInt32: return integer<uint32_t>();
+      case Prim::Int64: return integer<int64_t>();
+      case Prim::UInt64: return integer<uint64_t>();
+      case Prim::Float32: {
+        float v;
+        if (!read(v)) return false;
+        append_float(out_, static_cast<double>(v));
+        return true;
+      }
+      case Prim::Float64: {
+        double v;
+        if (!read(v)) return false;
+        append_float(out_, v);
+        return true;
+      }
+      case Prim::String: return string_value(t.string_bound);
+      case Prim::WString: return fail("wstring fields are not supported");
+      case Prim::Message: return message(*t.message);
+    }
+    return fail("unknown type");
+  }
+
+  static size_t min_size(const FieldType& t) {
+    if (t.prim == Prim::String || t.prim == Prim::WString) return 4;
+    if (t.prim == Prim::Message) return 1;
+    return msg::prim_size(t.prim);
+  }
+
+  bool field(const FieldType& t) {
+    if (t.array == ArrayKind::None) return scalar(t);
+    uint32_t n = t.array_size;
+    if (t.array != ArrayKind::Fixed) {
+      if (!count(n, min_size(t))) return false;
+      if (t.array == ArrayKind::Bounded && n > t.array_size) {
+        pos_ -= 4;
+        return fail("sequence of " + std::to_string(n) + " elements over its bound " + std::to_string(t.array_size));
+      }
+    }
+    out_ += '[';
+    size_t path_size = path_.size();
+    for (uint32_t i = 0; i < n; ++i) {
+      if (i) out_ += ',';
+      path_ += '[' + std::to_string(i) + ']';
+      if (!scalar(t)) return false;
+      path_.resize(path_size);
+    }
+    out_ += ']';
+    return true;
+  }
+
+  const unsigned char* data_;
+  size_t size_;
+  size_t pos_ = 0;
+  bool swap_;
+  std::string& out_;
+  CdrError& error_;
+  std::string path_;
+};
+
+// ------------------------------------------------------------------ encoding
+
+class Writer {
+ public:
+  Writer(std::string& out, bool big_endian, std::string& error)
+      : out_(out), swap_(big_endian == kHostLittle), error_(error) {}
+
+  bool message(const MessageType& type, simdjson::dom::element value, bool present) {
+    simdjson::dom::object obj;
+    if (present) {
+      if (value.get(obj) != simdjson::SUCCESS) return fail("expected an object for " + type.full_name());
+      for (auto member : obj) {  // every key must be a field
+        bool known = false;
+        for (const Field& f : type.fields) known = known || f.name == member.key;
+        if (!known) return fail("unknown field '" + std::string(member.key) + "' (not in " + type.full_name() + ")");
+      }
+    }
+    if (type.fields.empty()) {
+      put<uint8_t>(0);
+      return true;
+    }
+    for (const Field& f : type.fields) {
+      size_t path_size = path_.size();
+      if (!path_.empty()) path_ += '.';
+      path_ += f.name;
+      simdjson::dom::element v;
+      bool has = present && obj[f.name].get(v) == simdjson::SUCCESS;
+      if (!has && !f.default_text.empty()) {
+        if (default_doc(f, v)) has = true;
+      }
+      if (!field(f.type, v, has)) return false;
+      path_.resize(path_size);
+    }
+    return true;
+  }
+
+ private:
+  bool fail(const std::string& what) {
+    error_ = path_.empty() ? what : "field " + path_ + ": " + what;
+    return false;
+  }
+
+  // The .msg default of a field, as a JSON value ("1.5", "true", "\"text\"", "[1, 2]").
+  bool default_doc(const Field& f, simdjson::dom::element& v) {
+    std::string text = f.default_text;
+    bool is_string = f.type.prim == Prim::String && f.type.array == ArrayKind::None;
+    if (is_string && (text.empty() || (text.front() != '"' && text.front() != '\''))) text = "\"" + text + "\"";
+    if (is_string && text.front() == '\'') text = "\"" + text.substr(1, text.size() - 2) + "\"";
+    if (text == "True") text = "true";
+    if (text == "False") text = "false";
+    defaults_.push_back(std::make_unique<simdjson::dom::parser>());
+    return defaults_.back()->parse(text).get(v) == simdjson::SUCCESS;
+  }
+
+  void align(size_t n) {
+    while ((out_.size() - kHeader) % n) out_.push_back('\0');
+  }
+
+  template <typename T>
+  void put(T v) {
+    align(sizeof(T));
+    if (swap_ && sizeof(T) > 1) v = byteswap(v);
+    char b[sizeof(T)];
+    std::memcpy(b, &v, sizeof(T));
+    out_.append(b, sizeof(T));
+  }
+
+  template <typename T>
+  bool integer(simdjson::dom::element v, bool has) {
+    if (!has) {
+      put<T>(0);
+      return true;
+    }
+    int64_t i;
+    uint64_t u;
+    double d;
+    if (v.get(i) == simdjson::SUCCESS) {
+      if constexpr (std::is_signed_v<T>) {
+        if (i < std::numeric_limits<T>::min() || i > std::numeric_limits<T>::max()) return range(v);
+      } else {
+        if (i < 0 || static_cast<uint64_t>(i) > std::numeric_limits<T>::max()) return range(v);
+      }
+      put<T>(static_cast<T>(i));
+      return true;
+    }
+    if (v.get(u) == simdjson::SUCCESS) {
+      if (u > static_cast<uint64_t>(std::numeric_limits<T>::max())) return range(v);
+      put<T>(static_cast<T>(u));
+      return true;
+    }
+    if (v.get(d) == simdjson::SUCCESS) return fail("expected an integer, got " + simdjson::to_string(v));
+    if (v.is_bool()) return fail("expected an integer, got a bool");
+    return fail("expected an integer, got " + simdjson::to_string(v));
+  }
+
+  bool range(simdjson::dom::element v) { return fail(simdjson::to_string(v) + " is out of range"); }
+
+  template <typename T>
+  bool floating(simdjson::dom::element v, bool has) {
+    double d = 0;
+    if (has) {
+      if (v.is_null()) d = std::numeric_limits<double>::quiet_NaN();  // cdr_to_json writes NaN and infinities as null
+      else if (v.get(d) != simdjson::SUCCESS) return fail("expected a number, got " + simdjson::to_string(v));
+    }
+    put<T>(static_cast<T>(d));
+    return true;
+  }
+
+  bool scalar(const FieldType& t, simdjson::dom::element v, bool has) {
+    switch (t.prim) {
+      case Prim::Bool: {
+        bool b = false;
+        if (has && v.get(b) != simdjson::SUCCESS) return fail("expected true or false, got " + simdjson::to_string(v));
+        put<uint8_t>(b ? 1 : 0);
+        return true;
+      }
+      case Prim::Byte: case Prim::Char: case Prim::UInt8: return integer<uint8_t>(v, has);
+      case Prim::Int8: return integer<int8_t>(v, has);
+      case Prim::Int16: return integer<int16_t>(v, has);
+      case Prim::UInt16: return integer<uint16_t>(v, has);
+      case Prim::Int32: return integer<int32_t>(v, has);
+      case Prim::UInt32: return integer<uint32_t>(v, has);
+      case Prim::Int64: return integer<int64_t>(v, has);
+      case Prim::UInt64: return integer<uint64_t>(v, has);
+      case Prim::Float32: return floating<float>(v, has);
+      case Prim::Float64: return floating<double>(v, has);
+      case Prim::String: {
+        std::string_view s;
+        if (has && v.get(s) != simdjson::SUCCESS) return fail("expected a string, got " + simdjson::to_string(v));
+        if (s.find('\0') != std::string_view::npos) return fail("a string cannot hold a NUL");
+        if (t.string_bound && s.size() > t.string_bound)
+          return fail("string of " + std::to_string(s.size()) + " bytes over its bound " + std::to_string(t.string_bound));
+        put<uint32_t>(static_cast<uint32_t>(s.size() + 1));
+        out_.append(s.data(), s.size());
+        out_.push_back('\0');
+        return true;
+      }
+      case Prim::WString: return fail("wstring fields are not supported");
+      case Prim::Message: return message(*t.message, v, has);
+    }
+    return fail("unknown type");
+  }
+
+  bool field(const FieldType& t, simdjson::dom::element v, bool has) {
+    if (t.array == ArrayKind::None) return scalar(t, v, has);
+    simdjson::dom::array arr;
+    size_t n = 0;
+    if (has) {
+      if (v.get(arr) != simdjson::SUCCESS) return fail("expected an array, got " + simdjson::to_string(v));
+      n = arr.size();
+    }
+    if (t.array == ArrayKind::Fixed) {
+      if (has && n != t.array_size)
+        return fail("expected " + std::to_string(t.array_size) + " elements, got " + std::to_string(n));
+      n = t.array_size;
+    } else {
+      if (t.array == ArrayKind::Bounded && n > t.array_size)
+        return fail(std::to_string(n) + " elements over the bound " + std::to_string(t.array_size));
+      put<uint32_t>(static_cast<uint32_t>(n));
+    }
+    size_t path_size = path_.size();
+    size_t i = 0;
+    if (has) {
+      for (auto e : arr) {
+        path_ += '[' + std::to_string(i++) + ']';
+        if (!scalar(t, e, true)) return false;
+        path_.resize(path_size);
+      }
+    } else {
+      for (; i < n; ++i)
+        if (!scalar(t, simdjson::dom::element(), false)) return false;
+    }
+    return true;
+  }
+
+  std::string& out_;
+  bool swap_;
+  std::string& error_;
+  std::string path_;
+  std::vector<std::unique_ptr<simdjson::dom::parser>> defaults_;
+};
+
+}  // namespace
+
+bool cdr_to_json(const MessageType& type, std::string_view sample, std::string& out, CdrError& error) {
+  if (sample.size() < kHeader) {
+    error = {"sample of " + std::to_string(sample.size()) + " bytes has no 4-byte CDR header", 0};
+    return false;
+  }
+  auto b0 = static_cast<unsigned char>(sample[0]), b1 = static_cast<unsigned char>(sample[1]);
+  if (b0 != 0 || b1 > 1) {
+    const char* what = b0 == 0 && (b1 == 2 || b1 == 3)   ? " (parameter-list CDR)"
+                       : b0 == 0 && b1 >= 6 && b1 <= 11 ? " (XCDR2, not ROS 2's plain CDR)"
+                                                        : "";
+    error = {"unsupported CDR representation 0x" + std::string(1, "0123456789abcdef"[b0 >> 4]) +
+                 "0123456789abcdef"[b0 & 15] + "0123456789abcdef"[b1 >> 4] + "0123456789abcdef"[b1 & 15] + what,
+             0};
+    return false;
+  }
+  Reader r(sample, b1 == 1, out, error);
+  return r.message(type) && r.finish();
+}
+
+bool json_to_cdr(const MessageType& type, std::string_view json, std::string& sample, std::string& error,
+                 const CdrWriteOptions& options) {
+  simdjson::dom::parser parser;
+  simdjson::dom::element doc;
+  if (auto e = parser.parse(json.data(), json.size()).get(doc); e != simdjson::SUCCESS) {
+    error = std::string("not JSON: ") + simdjson::error_message(e);
+    return false;
+  }
+  sample.assign({'\0', options.big_endian ? '\0' : '\1', '\0', '\0'});
+  Writer w(sample, options.big_endian, error);
+  return w.message(type, doc, true);
+}
+
+}  // namespace rvc::io

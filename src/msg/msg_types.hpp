@@ -1,0 +1,71 @@
+// ROS 2 message types as read from .msg definitions at run time: the fields
+// (in wire order) and constants of one message, with nested message types
+// resolved to pointers into the TypeRegistry that owns them.
+#pragma once
+
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace rvc::msg {
+
+enum class Prim : uint8_t {
+  Bool, Byte, Char, Int8, UInt8, Int16, UInt16, Int32, UInt32, Int64, UInt64, Float32, Float64,
+  String, WString,
+  Message,  // a nested message type
+};
+
+// Size and alignment of a primitive in CDR (strings and messages: 0).
+size_t prim_size(Prim p);
+const char* prim_name(Prim p);
+bool prim_is_integer(Prim p);
+bool prim_is_float(Prim p);
+
+enum class ArrayKind : uint8_t { None, Fixed, Bounded, Unbounded };
+
+struct MessageType;
+
+struct FieldType {
+  Prim prim = Prim::Int32;
+  std::string type_name;                // Message: "pkg/msg/Name"
+  const MessageType* message = nullptr; // Message: set by TypeRegistry::resolve
+  uint32_t string_bound = 0;            // string<=N; 0: unbounded
+  ArrayKind array = ArrayKind::None;
+  uint32_t array_size = 0;              // Fixed: the size; Bounded: the bound
+  std::string to_string() const;        // as written in a .msg: "uint8[<=4]"
+};
+
+struct Field {
+  std::string name;
+  FieldType type;
+  std::string default_text;  // "float64 x 1.5": "1.5" (as written; empty: none)
+  int line = 0;
+};
+
+struct Constant {
+  std::string name;
+  Prim prim = Prim::Int32;
+  std::string text;          // the value as written (strings unquoted)
+  double number = 0;         // numeric and bool constants
+  int line = 0;
+};
+
+struct MessageType {
+  std::string package, name;     // "geometry_msgs", "Twist"
+  std::vector<Field> fields;     // in wire order; empty messages carry one uint8 on the wire
+  std::vector<Constant> constants;
+  std::string source;            // where the definition came from (file path, "bundled", "mcap schema")
+
+  std::string full_name() const { return package + "/msg/" + name; }
+  const Constant* constant(const std::string& constant_name) const;
+};
+
+// A definition that cannot be read or a type that cannot be resolved: names
+// the source, line and column.
+class MsgError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+}  // namespace rvc::msg

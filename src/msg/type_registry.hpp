@@ -1,0 +1,50 @@
+// Finds, parses and links ROS 2 message types by name, from (in this order)
+// definitions added in-process (an MCAP bag's schemas), folders given with
+// --msg-path, and the definitions bundled with rvc (builtin_interfaces,
+// std_msgs, geometry_msgs and the Autoware messages of the paper's Table 3).
+#pragma once
+
+#include <map>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "msg/msg_types.hpp"
+
+namespace rvc::msg {
+
+class TypeRegistry {
+ public:
+  // A registry that knows the bundled definitions only.
+  TypeRegistry();
+
+  // A folder of definitions: a ROS 2 install or share/ tree (<dir>/<pkg>/msg/<Name>.msg,
+  // <dir>/share/<pkg>/msg/<Name>.msg) or a plain folder (<dir>/<Name>.msg, any package).
+  void add_search_path(const std::string& dir);
+  // One definition's text, e.g. from a bag's schema record.
+  void add_definition(const std::string& type_name, std::string text, const std::string& source);
+  // An MCAP "ros2msg" schema: the type's definition followed by those it uses,
+  // each after a line of '=' and a line "MSG: pkg/Name".
+  void add_concatenated(const std::string& type_name, std::string_view text, const std::string& source);
+
+  // The type and every type it uses, parsed and linked. Accepts "pkg/msg/Name",
+  // "pkg/Name" and the DDS name "pkg::msg::dds_::Name_". Throws MsgError.
+  const MessageType& resolve(std::string_view type_name);
+
+  // Names of the bundled types ("pkg/msg/Name"), sorted.
+  static std::vector<std::string> bundled_types();
+
+ private:
+  const MessageType& load(const std::string& package, const std::string& name, int depth);
+  bool find_text(const std::string& package, const std::string& name, std::string& text, std::string& source) const;
+
+  std::vector<std::string> search_paths_;
+  std::map<std::string, std::pair<std::string, std::string>> added_;  // full name -> (text, source)
+  std::map<std::string, std::unique_ptr<MessageType>> types_;        // full name -> linked type
+};
+
+// The .msg text of a bundled type; a null string_view (data() == nullptr) if none.
+std::string_view bundled_definition(std::string_view full_name);
+
+}  // namespace rvc::msg

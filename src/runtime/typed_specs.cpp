@@ -1,0 +1,102 @@
+#include "runtime/typed_specs.hpp"
+
+#include <functional>
+#include <optional>
+#include <map>
+
+#include "spec/parser.hpp"
+#include "spec/spec_error.hpp"
+
+namespace rvc::runtime {
+namespace {
+
+using msg::ArrayKind;
+using msg::MessageType;
+using msg::Prim;
+
+std::string list_fields(const MessageType& t) {
+  std::string s;
+  for (const auto& f : t.fields) s += (s.empty() ? "" : ", ") + f.name;
+  return s.empty() ? "none" : s;
+}
+
+std::string list_constants(const MessageType& t) {
+  std::string s;
+  for (const auto& c : t.constants) s += (s.empty() ? "" : ", ") + c.name;
+  return s.empty() ? "none" : s;
+}
+
+// The value a test compares with, or nullopt when it stays as written.
+std::optional<spec::Literal> check_test(const spec::FieldTest& test, const MessageType& root, bool dense,
+                                        const std::string& time_field, const std::string& text) {
+  if (dense && test.path.size() == 1 && test.path[0] == time_field) return std::nullopt;
+  const MessageType* holder = &root;
+  const msg::Field* field = nullptr;
+  for (size_t i = 0; i < test.path.size(); ++i) {
+    if (!holder) {
+      throw spec::SpecError("field '" + test.key() + "': '" + test.path[i - 1] + "' is not a message", text,
+                            test.column);
+    }
+    field = nullptr;
+    for (const auto& f : holder->fields)
+      if (f.name == test.path[i]) field = &f;
+    if (!field) {
+      std::string where = i ? "'" + test.path[i - 1] + "' (" + holder->full_name() + ")" : holder->full_name();
+      throw spec::SpecError("no field '" + test.path[i] + "' in " + where + "; its fields: " + list_fields(*holder),
+                            text, test.column);
+    }
+    if (i + 1 < test.path.size()) {
+      holder = field->type.prim == Prim::Message && field->type.array == ArrayKind::None ? field->type.message
+                                                                                        : nullptr;
+    }
+  }
+  const bool numeric = field->type.array == ArrayKind::None && field->type.prim != Prim::Message &&
+                       field->type.prim != Prim::String && field->type.prim != Prim::WString;
+  if (!numeric || test.value.kind != spec::Literal::Kind::String || !test.value.bare_word) return std::nullopt;
+  const msg::Constant* c = holder->constant(test.value.text);
+  if (!c) {
+    throw spec::SpecError("'" + test.value.text + "' is not a constant of " + holder->full_name() +
+                              " (its constants: " + list_constants(*holder) + ")",
+                          text, test.column);
+  }
+  spec::Literal lit;
+  if (c->prim == Prim::Bool) {
+    lit.kind = spec::Literal::Kind::Bool;
+    lit.b = c->number != 0;
+  } else {
+    lit.kind = spec::Literal::Kind::Number;
+    lit.number = c->number;
+  }
+  return lit;
+}
+
+}  // namespace
+
+void bind_message_type(engine::Checker& checker, const std::vector<engine::PropertySpec>& properties,
+                       const MessageType& type, bool dense, const std::string& time_field) {
+  std::map<std::string, spec::Literal> resolved;  // canonical test text -> its value
+  spec::ParseOptions options;
+  options.dense = dense;
+  for (const auto& p : properties) {
+    try {
+      spec::NodePtr ast = spec::parse(p.spec, options);
+      std::function<void(const spec::Node&)> walk = [&](const spec::Node& n) {
+        if (n.op == spec::Op::Test) {
+          if (auto lit = check_test(n.test, type, dense, time_field, p.spec)) resolved[n.test.to_string()] = *lit;
+        }
+        if (n.left) walk(*n.left);
+        if (n.right) walk(*n.right);
+      };
+      walk(*ast);
+    } catch (const spec::SpecError& e) {
+      throw spec::SpecError("in property '" + p.name + "': " + e.message(), e.source(), e.column());
+    }
+  }
+  auto& atoms = checker.atoms();
+  for (size_t id = 0; id < atoms.size(); ++id) {
+    auto it = resolved.find(atoms.tests()[id].to_string());
+    if (it != resolved.end()) atoms.set_value(static_cast<int>(id), it->second);
+  }
+}
+
+}  // namespace rvc::runtime
