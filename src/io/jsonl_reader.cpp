@@ -78,7 +78,10 @@ class ChunkProcessor {
         bool pending = false;
         size_t pending_at = 0;
         for (auto it = stream.begin(); it != stream.end(); ++it) {
+          // simdjson may place the first document at offset 0 when blank lines
+          // come first: layouts and line numbers count from its first byte.
           size_t at = it.current_index();
+          while (at < fast_len && (buf[at] == ' ' || buf[at] == '\t' || buf[at] == '\r' || buf[at] == '\n')) ++at;
           if (pending) {
             pending = false;
             Layout l = layout(buf, pending_at, at);

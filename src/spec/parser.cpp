@@ -19,7 +19,14 @@ bool is_ident_char(char c) { return std::isalnum(static_cast<unsigned char>(c)) 
 // nest a few dozen levels; and/or chains longer than 64 terms are built as
 // balanced trees (both operators are associative), so `{a} or {b} or ...`
 // with 50,000 terms is 16 levels high, not 50,000.
+//
+// Two limits: the formula's height (kMaxNesting operators), and the written
+// nesting the parser recurses over (parentheses and prefix operators). The
+// printed form of a formula wraps each operator in parentheses, so the second
+// limit leaves room for twice the first: whatever is accepted prints to text
+// that is accepted again (the fuzz_spec oracle).
 inline constexpr int kMaxNesting = 1000;
+inline constexpr int kMaxWrittenNesting = 2 * kMaxNesting + 8;
 // Discrete bounds are step counts kept in a double: integers up to 2^53 are exact.
 inline constexpr uint64_t kMaxDiscreteBound = uint64_t{1} << 53;
 
@@ -32,6 +39,7 @@ class Parser {
     if (at_end()) fail("the specification is empty", 0);
     NodePtr node = parse_quantified();
     skip_ws();
+    check_height(*node);
     if (!at_end()) {
       if (peek() == ')') fail("unmatched ')'", pos_);
       if (peek_word("since") || peek_word("S"))
@@ -42,6 +50,20 @@ class Parser {
   }
 
  private:
+  // Without recursion: the tree may be up to kMaxWrittenNesting high here.
+  void check_height(const Node& root) const {
+    std::vector<std::pair<const Node*, int>> todo{{&root, 1}};
+    while (!todo.empty()) {
+      auto [n, h] = todo.back();
+      todo.pop_back();
+      if (h > kMaxNesting)
+        throw SpecError("formula nested deeper than " + std::to_string(kMaxNesting) + " levels (the limit)", s_,
+                        n->column > 0 ? n->column : 1);
+      if (n->left) todo.push_back({n->left.get(), h + 1});
+      if (n->right) todo.push_back({n->right.get(), h + 1});
+    }
+  }
+
   const std::string& s_;
   ParseOptions opt_;
   size_t pos_ = 0;
@@ -68,8 +90,10 @@ class Parser {
   class Nest {
    public:
     Nest(Parser& p, size_t at) : p_(p) {
-      if (++p_.nesting_ > kMaxNesting)
-        p_.fail("formula nested deeper than " + std::to_string(kMaxNesting) + " levels (the limit)", at);
+      if (++p_.nesting_ > kMaxWrittenNesting)
+        p_.fail("formula nested deeper than " + std::to_string(kMaxWrittenNesting) +
+                    " levels of parentheses and operators (the limit)",
+                at);
     }
     ~Nest() { --p_.nesting_; }
 

@@ -240,3 +240,27 @@ TEST(Pipeline, DenseBoundedOperatorOverAFile) {
 
 }  // namespace
 }  // namespace rvc::runtime
+
+namespace rvc::runtime {
+namespace {
+
+// Found by fuzz_jsonl (file vs topic oracle): the same lines read in chunks
+// of any size give the same messages, verdicts and rejections.
+TEST(Pipeline, FuzzFoundChunkSizeDoesNotChangeResults) {
+  const std::string text = std::string("\n{\"time\":2-\"x\"20}\n{\"time\":1,\"x\":0}\n{\"time") +
+                           std::string("\x01\0\0\0\0\0\0\x01", 8) + ":q2,\"}";
+  PipelineOptions o = discrete_all();
+  o.model = engine::TimeModel::Dense;
+  o.max_message_size = 24;
+  const std::vector<engine::PropertySpec> props = {{"a", "{x > 0} since ({y} or {s == \"w\"})"}};
+  Result big = run(props, o, text, chunked(1 << 20, 24));
+  for (size_t chunk : {1, 2, 5, 16, 17, 40}) {
+    Result r = run(props, o, text, chunked(chunk, 24));
+    EXPECT_EQ(r.verdicts, big.verdicts) << chunk << "\n" << r.stderr_text << "\n--- big:\n" << big.stderr_text;
+    EXPECT_EQ(r.stats.accepted, big.stats.accepted) << chunk;
+    EXPECT_EQ(r.stats.rejected, big.stats.rejected) << chunk << "\n" << r.stderr_text << "\n--- big:\n" << big.stderr_text;
+  }
+}
+
+}  // namespace
+}  // namespace rvc::runtime
