@@ -59,6 +59,8 @@ struct ReplayCommand {
       std::fprintf(stderr, "rvc: cannot open '%s'\n", file.c_str());
       return kUsage;
     }
+    // Closed on every way out (no subscriber, a sink that throws).
+    std::unique_ptr<std::FILE, int (*)(std::FILE*)> in_owner(in != stdin ? in : nullptr, &std::fclose);
     long total_bytes = 0;
     if (in != stdin && std::fseek(in, 0, SEEK_END) == 0) {
       total_bytes = std::ftell(in);
@@ -96,8 +98,13 @@ struct ReplayCommand {
       }
     }
     const bool show = progress && isatty(2);
+    // Freed on every way out: a sink that cannot write throws (exit 5).
     char* line = nullptr;
     size_t cap = 0;
+    struct FreeLine {
+      char*& p;
+      ~FreeLine() { std::free(p); }
+    } free_line{line};  // getline may move the buffer: free whatever it holds last
     ssize_t n;
     uint64_t seq = 0;
     long bytes = 0;
@@ -160,8 +167,7 @@ struct ReplayCommand {
       }
     }
     if (!pending.empty()) send(pending);
-    std::free(line);
-    if (in != stdin) std::fclose(in);
+    in_owner.reset();
     seq = samples;  // sequence numbers count samples
     if (!no_eos) sink->put_eos(samples);
     sink->flush();

@@ -428,6 +428,8 @@ bool json_to_cdr(const MessageType& type, std::string_view json, std::string& sa
   simdjson::dom::element doc;
   if (auto e = parser.parse(json.data(), json.size()).get(doc); e != simdjson::SUCCESS) {
     error = std::string("not JSON: ") + simdjson::error_message(e);
+    // simdjson's DOM refuses integer literals of 20 digits or more.
+    if (e == simdjson::NUMBER_ERROR) error += " (write integers beyond 2^64 in exponent form, e.g. 5.9e+20)";
     return false;
   }
   sample.assign({'\0', options.big_endian ? '\0' : '\1', '\0', '\0'});

@@ -41,7 +41,11 @@ void append_number(std::string& out, double v) {
     out.append(buf, p);
     return;
   }
-  auto [p, ec] = std::to_chars(buf, buf + sizeof buf, v);
+  // Integral values from 9e15 up in scientific form: the shortest form of 2^69
+  // is 21 plain digits, an integer too big for simdjson's DOM (rvc msg encode
+  // refused what rvc msg decode wrote, found by fuzz_cdr).
+  const auto format = v == std::floor(v) ? std::chars_format::scientific : std::chars_format::general;
+  auto [p, ec] = std::to_chars(buf, buf + sizeof buf, v, format);
   out.append(buf, p);
 }
 

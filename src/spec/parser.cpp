@@ -2,10 +2,14 @@
 // is small, and a hand-written scanner gives exact columns for every error.
 #include "spec/parser.hpp"
 
+#include <pthread.h>
+
 #include <cctype>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
+#include <exception>
+#include <system_error>
 #include <vector>
 
 namespace rvc::spec {
@@ -484,10 +488,47 @@ class Parser {
   }
 };
 
+// The parser recurses about seven frames per written level, so the
+// kMaxWrittenNesting levels it accepts need more stack than a thread's default
+// 8 MiB under ASan (the sanitizer tier overflowed at ~2000 levels). Long specs
+// are parsed on a thread of their own with a stack that leaves a wide margin
+// in every build; it is reserved, not touched, so it costs only what is used.
+// Short specs cannot nest deeply and stay on the caller's thread.
+constexpr size_t kParserStack = size_t{256} << 20;
+constexpr size_t kShortSpec = 256;
+
+struct ParseJob {
+  const std::string* text;
+  const ParseOptions* options;
+  NodePtr result;
+  std::exception_ptr error;
+};
+
+void* run_parse_job(void* arg) {
+  auto* job = static_cast<ParseJob*>(arg);
+  try {
+    job->result = Parser(*job->text, *job->options).parse_all();
+  } catch (...) {
+    job->error = std::current_exception();
+  }
+  return nullptr;
+}
+
 }  // namespace
 
 NodePtr parse(const std::string& text, const ParseOptions& options) {
-  return Parser(text, options).parse_all();
+  if (text.size() <= kShortSpec) return Parser(text, options).parse_all();
+  ParseJob job{&text, &options, nullptr, nullptr};
+  pthread_attr_t attr;
+  pthread_attr_init(&attr);
+  pthread_attr_setstacksize(&attr, kParserStack);
+  pthread_t thread;
+  const int rc = pthread_create(&thread, &attr, run_parse_job, &job);
+  pthread_attr_destroy(&attr);
+  if (rc != 0) throw std::system_error(rc, std::generic_category(), "cannot start the spec parser's thread");
+  pthread_join(thread, nullptr);
+  if (job.error) std::rethrow_exception(job.error);
+  return std::move(job.result);
 }
 
 }  // namespace rvc::spec

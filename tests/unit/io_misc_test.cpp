@@ -1,12 +1,14 @@
 // Verdict output (JSON lines) and the properties file loader.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
 
 #include "io/properties_file.hpp"
 #include "io/verdict_writer.hpp"
+
 #include "test_util.hpp"
 
 namespace rvc::io {
@@ -26,6 +28,11 @@ TEST(VerdictWriter, NumbersInShortestForm) {
   EXPECT_EQ(number(0.1), "0.1");  // shortest round-trip, not 0.1000000000000000055
   EXPECT_EQ(number(1e20), "1e+20");
   EXPECT_EQ(number(123456789012), "123456789012");
+  // Found by fuzz_cdr: 2^69's shortest plain form is 21 digits, which a JSON
+  // reader may refuse as an integer; integral values that large use an exponent.
+  EXPECT_EQ(number(std::ldexp(1.0, 69)), "5.902958103587057e+20");
+  EXPECT_EQ(number(-std::ldexp(1.0, 69)), "-5.902958103587057e+20");
+  EXPECT_EQ(number(9007199254740992.0), "9.007199254740992e+15");
 }
 
 TEST(VerdictWriter, JsonStringEscapes) {
