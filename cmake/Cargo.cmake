@@ -26,6 +26,10 @@ set(RVC_CARGO_JOBS 2 CACHE STRING "Parallel jobs for cargo builds")
 set(RVC_CARGO_TARGET_DIR "$ENV{RVC_CARGO_TARGET_DIR}" CACHE PATH
     "cargo target dir (default: <build tree>/cargo-target)")
 
+# A folder with lib<LIB_NAME>.a already built from the same rust/ sources (the
+# image build reuses the host's, deploy/docker/build.sh --zenoh-lib): no cargo run.
+set(RVC_PREBUILT_RUST_LIBS "" CACHE PATH "Folder of prebuilt Rust staticlibs (skips cargo)")
+
 find_program(CARGO_EXECUTABLE cargo
   HINTS "$ENV{CARGO_HOME}/bin" "$ENV{HOME}/.cargo/bin"
   DOC "cargo, to build the Rust parts of rvc")
@@ -34,6 +38,19 @@ function(rvc_cargo_staticlib target)
   cmake_parse_arguments(ARG "" "MANIFEST_DIR;LIB_NAME" "" ${ARGN})
   if(NOT ARG_MANIFEST_DIR OR NOT ARG_LIB_NAME)
     message(FATAL_ERROR "rvc_cargo_staticlib(${target}): MANIFEST_DIR and LIB_NAME are required")
+  endif()
+  if(RVC_PREBUILT_RUST_LIBS)
+    set(lib "${RVC_PREBUILT_RUST_LIBS}/lib${ARG_LIB_NAME}.a")
+    if(NOT EXISTS "${lib}")
+      message(FATAL_ERROR "RVC_PREBUILT_RUST_LIBS: ${lib} does not exist")
+    endif()
+    message(STATUS "${target}: prebuilt ${lib} (no cargo build)")
+    add_custom_target(${target}_cargo)  # nothing to build; others may depend on it
+    add_library(${target} INTERFACE)
+    find_package(Threads REQUIRED)
+    target_link_libraries(${target} INTERFACE
+      "${lib}" Threads::Threads ${CMAKE_DL_LIBS} m rt util gcc_s)
+    return()
   endif()
   if(NOT CARGO_EXECUTABLE)
     message(FATAL_ERROR

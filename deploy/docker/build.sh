@@ -4,7 +4,12 @@
 #     the cargo registry and ccache persist between builds;
 #   - otherwise the legacy builder, fed the same Dockerfile with the RUN --mount flags removed.
 #
-#   deploy/docker/build.sh [--tag IMAGE] [--network host] [--no-cache] [--jobs N]
+#   deploy/docker/build.sh [--tag IMAGE] [--network host] [--no-cache] [--jobs N] [--zenoh-lib FILE]
+#
+# --zenoh-lib FILE: use FILE (librvc_zenoh.a from a host build of the same checkout, e.g.
+# build/release/cargo-target/release/librvc_zenoh.a) instead of compiling the Zenoh crate in the
+# image; the host must be Debian bookworm like the image. The test tier does this (one compile of
+# the crate per CI run instead of two); everything else in the image is built as usual.
 #
 # Environment: RVC_IMAGE (default rvc:latest), RVC_DOCKER (docker client to use),
 # RVC_DOCKER_BUILDER=buildkit|legacy (force one). Prints one JSON line at the end:
@@ -13,6 +18,7 @@ set -euo pipefail
 ROOT=$(cd "$(dirname "$0")/../.." && pwd)
 IMAGE=${RVC_IMAGE:-rvc:latest}
 JOBS=2
+ZENOH_LIB=""
 extra=()
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -20,7 +26,8 @@ while [ $# -gt 0 ]; do
     --network) extra+=(--network "$2"); shift 2 ;;
     --no-cache) extra+=(--no-cache); shift ;;
     --jobs) JOBS=$2; shift 2 ;;
-    -h|--help) sed -n '2,12p' "$0"; exit 0 ;;
+    --zenoh-lib) ZENOH_LIB=$2; shift 2 ;;
+    -h|--help) sed -n '2,17p' "$0"; exit 0 ;;
     *) echo "build.sh: unknown argument $1" >&2; exit 2 ;;
   esac
 done
@@ -46,6 +53,15 @@ if [ "${RVC_DOCKER_BUILDER:-}" = buildkit ] && [ "$builder" != buildkit ]; then
 fi
 
 cd "$ROOT"
+prebuilt=$ROOT/rust/prebuilt
+rm -rf "$prebuilt"
+zenoh=source
+if [ -n "$ZENOH_LIB" ]; then
+  [ -f "$ZENOH_LIB" ] || { echo "build.sh: --zenoh-lib $ZENOH_LIB: no such file" >&2; exit 2; }
+  mkdir -p "$prebuilt" && cp "$ZENOH_LIB" "$prebuilt/librvc_zenoh.a"
+  trap 'rm -rf "$prebuilt"' EXIT
+  zenoh=prebuilt
+fi
 start=$(date +%s.%N)
 echo "build.sh: $builder builder ($client), image $IMAGE" >&2
 if [ "$builder" = buildkit ]; then
@@ -57,5 +73,5 @@ else
 fi
 end=$(date +%s.%N)
 size=$("$client" image inspect -f '{{.Size}}' "$IMAGE")
-printf '{"image":"%s","builder":"%s","seconds":%.1f,"size_bytes":%s}\n' \
-  "$IMAGE" "$builder" "$(echo "$end - $start" | bc -l 2>/dev/null || python3 -c "print($end-$start)")" "$size"
+printf '{"image":"%s","builder":"%s","zenoh":"%s","seconds":%.1f,"size_bytes":%s}\n' \
+  "$IMAGE" "$builder" "$zenoh" "$(echo "$end - $start" | bc -l 2>/dev/null || python3 -c "print($end-$start)")" "$size"

@@ -44,8 +44,22 @@ def docker():
 
 
 @pytest.fixture(scope="session")
+def host_zenoh_lib():
+    """The Zenoh staticlib of the host build that made RVC_BIN, if any: the image reuses it instead
+    of compiling the crate a second time (RVC_IMAGE_ZENOH=source forces the full in-image build)."""
+    if os.environ.get("RVC_IMAGE_ZENOH") == "source" or not os.environ.get("RVC_BIN"):
+        return None
+    target = os.environ.get("RVC_CARGO_TARGET_DIR") or os.path.join(os.path.dirname(os.environ["RVC_BIN"]), "cargo-target")
+    lib = os.path.join(target, "release", "librvc_zenoh.a")
+    return lib if os.path.isfile(lib) else None
+
+
+@pytest.fixture(scope="session")
 def image(docker):
-    r = run([os.path.join(ROOT, "deploy", "docker", "build.sh"), "--tag", IMAGE], timeout=3600)
+    cmd = [os.path.join(ROOT, "deploy", "docker", "build.sh"), "--tag", IMAGE]
+    if host_zenoh_lib():
+        cmd += ["--zenoh-lib", host_zenoh_lib()]
+    r = run(cmd, timeout=3600)
     assert r.returncode == 0, "image build failed:\n" + r.stdout[-4000:] + r.stderr[-4000:]
     info = json.loads(r.stdout.strip().splitlines()[-1])
     print("\nimage:", json.dumps(info))
