@@ -43,7 +43,6 @@ def docker():
     return True
 
 
-@pytest.fixture(scope="session")
 def host_zenoh_lib():
     """The Zenoh staticlib of the host build that made RVC_BIN, if any: the image reuses it instead
     of compiling the crate a second time (RVC_IMAGE_ZENOH=source forces the full in-image build)."""
