@@ -74,15 +74,19 @@ struct MonitorCommand {
     runtime::VerdictOutputs verdicts(std::move(sinks), !check.dense);
     runtime::PipelineOptions popts = check.pipeline_options();
     popts.position_name = "seq";
+    transport::TransportOptions input_transports = transports;  // outputs stay std_msgs/String
     if (!type.empty()) {
       const std::string scheme = transport::scheme_of(input);
-      if (scheme != "zenoh") {
-        std::fprintf(stderr, "rvc: --type reads CDR payloads from a zenoh: input (as zenoh-bridge-ros2dds forwards "
-                             "them); %s inputs carry JSON\n", scheme.c_str());
+      if (scheme != "zenoh" && scheme != "dds") {
+        std::fprintf(stderr, "rvc: --type reads typed samples from a dds: topic or CDR payloads from a zenoh: key (as "
+                             "zenoh-bridge-ros2dds forwards them); %s inputs carry JSON\n", scheme.c_str());
         return kUsage;
       }
       for (const auto& p : msg_paths) registry.add_search_path(p);
       popts.type = &registry.resolve(type);
+#ifdef RVC_HAVE_DDS
+      input_transports.dds.ros_type = popts.type;
+#endif
     }
     runtime::Pipeline pipeline(properties, popts, [&](const engine::Verdict& v) { verdicts.put(v); });
 
@@ -99,7 +103,7 @@ struct MonitorCommand {
     lopts.stats_requested = stats_requested;
     runtime::MonitorLoop loop(pipeline, verdicts, stats_sink.get(), lopts);
 
-    auto source = transport::open_source(input, transports);
+    auto source = transport::open_source(input, input_transports);
     install_stop_signals();
     std::fprintf(stderr, "rvc monitor: %zu propert%s on %s -> %zu output%s\n", properties.size(),
                  properties.size() == 1 ? "y" : "ies", input.c_str(), verdicts.size(), verdicts.size() == 1 ? "" : "s");

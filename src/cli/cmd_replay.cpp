@@ -18,7 +18,9 @@
 #include "cli/commands.hpp"
 #include "cli/transport_flags.hpp"
 #include "cli/signals.hpp"
+#include "io/cdr_codec.hpp"
 #include "io/json_writer.hpp"
+#include "msg/type_registry.hpp"
 #include "transport/transport_options.hpp"
 
 namespace rvc::cli {
@@ -35,6 +37,10 @@ struct ReplayCommand {
   bool progress = true;
   size_t batch = 1;          // messages (lines) per published sample
   std::string latency_from;  // verdict endpoint of a monitor run with --all: measure publish -> verdict
+  std::string type;          // --type: each line is a message of this ROS 2 type, published as CDR
+  std::vector<std::string> msg_paths;
+  bool big_endian = false;
+  msg::TypeRegistry registry;
 
   static double wall_now() {
     return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
@@ -53,6 +59,24 @@ struct ReplayCommand {
                      rate.c_str());
         return kUsage;
       }
+    }
+    const msg::MessageType* ros_type = nullptr;
+    if (!type.empty()) {
+      const std::string scheme = transport::scheme_of(to);
+      if (scheme != "zenoh" && scheme != "dds") {
+        std::fprintf(stderr, "rvc: --type publishes typed samples to dds: or zenoh: endpoints; for CDR in a file "
+                             "use `rvc msg encode`\n");
+        return kUsage;
+      }
+      if (batch > 1) {
+        std::fprintf(stderr, "rvc: --type publishes one message per sample: --batch cannot be used with it\n");
+        return kUsage;
+      }
+      for (const auto& p : msg_paths) registry.add_search_path(p);
+      ros_type = &registry.resolve(type);
+#ifdef RVC_HAVE_DDS
+      transports.dds.ros_type = ros_type;
+#endif
     }
     std::FILE* in = file == "-" ? stdin : std::fopen(file.c_str(), "r");
     if (!in) {
@@ -111,7 +135,10 @@ struct ReplayCommand {
     auto t0 = std::chrono::steady_clock::now();
     const double started_at = wall_now();
     auto next_progress = t0;
-    uint64_t events = 0, samples = 0;
+    uint64_t events = 0, samples = 0, rejected = 0, line_no = 0;
+    std::string cdr, cdr_error;
+    io::CdrWriteOptions cdr_options;
+    cdr_options.big_endian = big_endian;
     std::string pending;  // --batch: lines waiting to go out as one sample
     size_t pending_lines = 0;
     auto send = [&](std::string_view payload) {
@@ -125,9 +152,16 @@ struct ReplayCommand {
     bool interrupted = false;
     while (!(interrupted = stop_requested()) && (n = ::getline(&line, &cap, in)) >= 0) {
       bytes += n;
+      ++line_no;
       size_t len = static_cast<size_t>(n);
       while (len > 0 && (line[len - 1] == '\n' || line[len - 1] == '\r')) --len;
       if (len == 0) continue;
+      if (ros_type && !io::json_to_cdr(*ros_type, std::string_view(line, len), cdr, cdr_error, cdr_options)) {
+        if (++rejected <= 100)
+          std::fprintf(stderr, "rvc: line %llu: not a %s: %s (message skipped)\n",
+                       static_cast<unsigned long long>(line_no), ros_type->full_name().c_str(), cdr_error.c_str());
+        continue;
+      }
       seq = events + 1;  // this message's number: counted as sent once it is sent
       // Wait for this message's slot in short steps, so that a stop signal
       // during the wait is seen before the message is sent.
@@ -142,7 +176,9 @@ struct ReplayCommand {
         }
       }
       ++events;
-      if (batch <= 1) {
+      if (ros_type) {
+        send(cdr);
+      } else if (batch <= 1) {
         send(std::string_view(line, len));
       } else {
         pending.append(line, len);
@@ -197,7 +233,9 @@ struct ReplayCommand {
     }
     io::JsonObject summary;
     summary.add("sent", events)
-        .add("samples", samples)
+        .add("samples", samples);
+    if (ros_type) summary.add("rejected", rejected);
+    summary
         .add_fixed("seconds", s, 6)
         .add_fixed("msgs_per_s", s > 0 ? events / s : 0.0, 1)
         .add_fixed("started_at", started_at, 6);
@@ -207,12 +245,17 @@ struct ReplayCommand {
                          ? stderr
                          : stdout;
     std::fprintf(out, "%s\n", summary.str().c_str());
+    if (rejected > 0) {
+      std::fprintf(stderr, "rvc replay: %llu line%s could not be converted to %s and %s not sent\n",
+                   static_cast<unsigned long long>(rejected), rejected == 1 ? "" : "s", ros_type->full_name().c_str(),
+                   rejected == 1 ? "was" : "were");
+    }
     if (interrupted) {
       std::fprintf(stderr, "rvc replay: stopped by a signal after %llu of the input's messages: incomplete\n",
                    static_cast<unsigned long long>(events));
       return kIncomplete;
     }
-    return kOk;
+    return rejected > 0 ? kBadInput : kOk;
   }
 };
 
@@ -235,6 +278,12 @@ Runner register_replay(CLI::App& app) {
   sub->add_flag("!--no-progress", cmd->progress, "No progress line on a terminal");
   sub->add_option("--latency-from", cmd->latency_from,
                   "Verdict endpoint of an `rvc monitor --all`: report publish-to-verdict latency percentiles");
+  sub->add_option("--type", cmd->type,
+                  "ROS 2 message type of the lines, pkg/msg/Name: each line is converted to a CDR sample and published "
+                  "typed (`rvc msg list`)");
+  sub->add_option("--msg-path", cmd->msg_paths,
+                  "Folder of .msg definitions for --type: a ROS 2 share/ tree or a plain folder (repeatable)");
+  sub->add_flag("--big-endian", cmd->big_endian, "With --type: big-endian CDR (default: little endian)");
   add_transport_options(*sub, cmd->transports);
   return [cmd] { return cmd->run(); };
 }

@@ -25,5 +25,6 @@ Runner register_dds_config(CLI::App& app);  // only with the DDS transport
 Runner register_perf(CLI::App& app);
 Runner register_bridge(CLI::App& app);
 Runner register_msg(CLI::App& app);         // ROS 2 message types, CDR <-> JSON
+Runner register_echo(CLI::App& app);        // print an endpoint's messages as JSON lines
 
 }  // namespace rvc::cli

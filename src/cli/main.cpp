@@ -40,6 +40,7 @@ int main(int argc, char** argv) {
   runners["perf"] = register_perf(app);
   runners["bridge"] = register_bridge(app);
   runners["msg"] = register_msg(app);
+  runners["echo"] = register_echo(app);
 #ifdef RVC_HAVE_ZENOH
   runners["router"] = register_router(app);
 #endif

@@ -35,7 +35,7 @@ Parsed parse(const std::string& uri) {
                               "' (use file:PATH, -, zenoh:KEYEXPR or dds:TOPIC)");
 }
 
-[[noreturn]] void not_built(const std::string& scheme) {
+[[noreturn, maybe_unused]] void not_built(const std::string& scheme) {
   throw std::invalid_argument("this rvc was built without the " + scheme + " transport (" +
                               (scheme == "zenoh" ? "RVC_WITH_ZENOH" : "RVC_WITH_DDS") + "=OFF)");
 }

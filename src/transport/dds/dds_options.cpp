@@ -14,7 +14,9 @@ namespace {
 
 constexpr int kMaxDomain = 232;  // 7400 + 250 * domain + offsets must stay below 65536
 constexpr const char* kQosItems =
-    "reliable, best-effort, keep-all, keep-last=N, volatile, transient-local, max-blocking=DURATION";
+    "reliable, best-effort, keep-all, keep-last=N, volatile, transient-local, max-blocking=DURATION, "
+    "or a ROS 2 profile: ros2-default (reliable, keep-last=10, volatile), sensor-data (best-effort, keep-last=5, "
+    "volatile)";
 
 std::string trim_lower(std::string_view s) {
   while (!s.empty() && std::isspace(static_cast<unsigned char>(s.front()))) s.remove_prefix(1);
@@ -74,12 +76,34 @@ bool is_loopback_interface(std::string_view iface) {
   return iface == "lo" || iface == "lo0" || iface.substr(0, 4) == "127." || iface == "::1";
 }
 
+
+// ROS 2's named profiles (rmw_qos_profile_default, rmw_qos_profile_sensor_data),
+// for subscribing to ROS 2 publishers as they are usually set up.
+std::string expand_profiles(std::string_view text) {
+  std::string out;
+  size_t pos = 0;
+  while (pos <= text.size()) {
+    size_t comma = text.find(',', pos);
+    if (comma == std::string_view::npos) comma = text.size();
+    std::string item(text.substr(pos, comma - pos));
+    const std::string key = trim_lower(item);
+    if (key == "ros2-default") item = "reliable,keep-last=10,volatile";
+    else if (key == "sensor-data") item = "best-effort,keep-last=5,volatile";
+    out += (out.empty() && pos == 0 ? "" : ",") + item;
+    if (comma == text.size()) break;
+    pos = comma + 1;
+  }
+  return out;
+}
+
 }  // namespace
 
-QosSpec parse_qos(std::string_view text) {
+QosSpec parse_qos(std::string_view original) {
+  const std::string expanded = expand_profiles(original);
+  const std::string_view text = expanded;
   QosSpec q;
   bool set_rel = false, set_hist = false, set_dur = false, set_block = false;
-  const std::string whole(text);
+  const std::string whole(original);
   auto conflict = [&](bool already, const std::string& item, const char* what) {
     if (already)
       throw std::invalid_argument("--qos: '" + item + "' contradicts an earlier " + what + " item in '" + whole + "'");

@@ -11,6 +11,10 @@
 #include <string_view>
 #include <vector>
 
+namespace rvc::msg {
+struct MessageType;
+}
+
 namespace rvc::transport {
 
 struct DdsOptions {
@@ -34,6 +38,12 @@ struct DdsOptions {
   // but only safe when the handler never waits for a DDS writer of this
   // process: a writer blocked on acknowledgements needs the receive thread.
   bool deliver_on_receive_thread = false;
+  // Set by commands (--type), not a flag of its own: the topic has this ROS 2
+  // type (pkg::msg::dds_::Name_, descriptor built at run time). Sources deliver
+  // each sample's CDR (with its encapsulation header) as the payload; sinks
+  // take CDR payloads and publish them as samples of the type. Typed topics
+  // carry no end-of-stream marker (a ROS 2 publisher sends none).
+  const msg::MessageType* ros_type = nullptr;
 };
 
 

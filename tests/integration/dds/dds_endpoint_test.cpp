@@ -103,6 +103,17 @@ TEST(DdsQos, Overrides) {
   EXPECT_EQ(dds::parse_qos("keep-last=4,keep-last=4").keep_last, 4);  // repeating is not contradicting
 }
 
+TEST(DdsQos, Ros2Profiles) {
+  auto d = dds::parse_qos("ros2-default");  // rmw_qos_profile_default
+  EXPECT_TRUE(d.reliable);
+  EXPECT_EQ(d.keep_last, 10);
+  EXPECT_FALSE(d.transient_local);
+  auto s = dds::parse_qos("Sensor-Data, max-blocking=1s");  // rmw_qos_profile_sensor_data, plus an item
+  EXPECT_FALSE(s.reliable);
+  EXPECT_EQ(s.keep_last, 5);
+  EXPECT_EQ(s.max_blocking, 1s);
+}
+
 void expect_qos_error(const std::string& text, const std::string& fragment) {
   try {
     dds::parse_qos(text);
@@ -123,6 +134,7 @@ TEST(DdsQos, ErrorsNameTheOffendingItem) {
   expect_qos_error("volatile,transient-local", "contradicts an earlier durability item");
   expect_qos_error("keep-all,keep-last=3", "contradicts an earlier history item");
   expect_qos_error("max-blocking=10", "needs a unit");
+  expect_qos_error("sensor-data,reliable", "in 'sensor-data,reliable'");  // the text as the user wrote it
   expect_qos_error("reliable,", "empty item");
   expect_qos_error("reliable=1", "unknown item 'reliable=1'");
 }

@@ -1,0 +1,128 @@
+// rvc echo: print what arrives on an endpoint as JSON lines, the `ros2 topic
+// echo` of rvc. With --type, samples are ROS 2 CDR (a dds: topic of that type,
+// or a zenoh: key as zenoh-bridge-ros2dds forwards it) decoded from the
+// message definition; without, payloads are printed as they are (rvc's JSON
+// strings). Ends after --count messages, at the end-of-stream marker, after
+// --idle-timeout seconds without a message, or on SIGINT/SIGTERM.
+#include <cerrno>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "cli/commands.hpp"
+#include "cli/signals.hpp"
+#include "cli/transport_flags.hpp"
+#include "io/cdr_codec.hpp"
+#include "msg/type_registry.hpp"
+#include "transport/frame_queue.hpp"
+#include "transport/transport_options.hpp"
+
+namespace rvc::cli {
+namespace {
+
+struct EchoCommand {
+  transport::TransportOptions transports;
+  std::string input;
+  std::string type;
+  std::vector<std::string> msg_paths;
+  uint64_t count = 0;        // 0: no limit
+  double idle_timeout = 0;   // 0: none
+  msg::TypeRegistry registry;
+
+  int run() {
+    const msg::MessageType* ros_type = nullptr;
+    if (!type.empty()) {
+      const std::string scheme = transport::scheme_of(input);
+      if (scheme != "dds" && scheme != "zenoh") {
+        std::fprintf(stderr, "rvc: --type reads dds: or zenoh: inputs; for CDR in a file use `rvc msg decode`\n");
+        return kUsage;
+      }
+      for (const auto& p : msg_paths) registry.add_search_path(p);
+      ros_type = &registry.resolve(type);
+#ifdef RVC_HAVE_DDS
+      transports.dds.ros_type = ros_type;
+#endif
+    }
+    transport::FrameQueue queue(1024);
+    auto source = transport::open_source(input, transports);
+    install_stop_signals();
+    source->start([&](const transport::Frame& f) { queue.push(f); });
+
+    std::vector<transport::OwnedFrame> batch;
+    std::string json;
+    uint64_t printed = 0, rejected = 0;
+    bool eos = false, failed_write = false;
+    auto last = std::chrono::steady_clock::now();
+    while (!stop_requested() && !eos && (count == 0 || printed < count)) {
+      size_t n = 0;
+      if (!queue.pop_batch(batch, n, 100)) break;
+      const auto now = std::chrono::steady_clock::now();
+      if (n == 0) {
+        if (idle_timeout > 0 && std::chrono::duration<double>(now - last).count() >= idle_timeout) break;
+        continue;
+      }
+      last = now;
+      for (size_t i = 0; i < n && (count == 0 || printed < count); ++i) {
+        const auto& f = batch[i];
+        if (f.eos) {
+          eos = true;
+          break;
+        }
+        std::string_view line = f.payload;
+        if (ros_type) {
+          io::CdrError error;
+          json.clear();  // cdr_to_json appends
+          if (!io::cdr_to_json(*ros_type, f.payload, json, error)) {
+            if (++rejected <= 100)
+              std::fprintf(stderr, "rvc: sample %llu: not a %s: %s (skipped)\n", static_cast<unsigned long long>(f.seq),
+                           ros_type->full_name().c_str(), error.to_string().c_str());
+            continue;
+          }
+          line = json;
+        }
+        if (std::fwrite(line.data(), 1, line.size(), stdout) != line.size() || std::fputc('\n', stdout) == EOF) {
+          failed_write = true;
+          break;
+        }
+        ++printed;
+      }
+      if (failed_write || std::fflush(stdout) != 0) {
+        std::fprintf(stderr, "rvc: cannot write to stdout: %s\n", std::strerror(errno));
+        source->stop();
+        queue.close();
+        return kRuntime;
+      }
+    }
+    source->stop();
+    queue.close();
+    if (rejected > 0) {
+      std::fprintf(stderr, "rvc echo: %llu sample%s could not be decoded\n", static_cast<unsigned long long>(rejected),
+                   rejected == 1 ? "" : "s");
+      return kBadInput;
+    }
+    return printed == 0 ? kIncomplete : kOk;
+  }
+};
+
+}  // namespace
+
+Runner register_echo(CLI::App& app) {
+  auto cmd = std::make_shared<EchoCommand>();
+  CLI::App* sub = app.add_subcommand("echo", "Print the messages of an endpoint as JSON lines (typed ROS 2 topics with --type)");
+  sub->add_option("input", cmd->input, "Endpoint: dds:TOPIC, zenoh:KEYEXPR, file:PATH")->required();
+  sub->add_option("--type", cmd->type, "ROS 2 message type of the samples, pkg/msg/Name (`rvc msg list`)");
+  sub->add_option("--msg-path", cmd->msg_paths,
+                  "Folder of .msg definitions for --type: a ROS 2 share/ tree or a plain folder (repeatable)");
+  sub->add_option("--count,-n", cmd->count, "Stop after this many messages (default: no limit)");
+  sub->add_option("--idle-timeout", cmd->idle_timeout, "Stop after this many seconds without a message")
+      ->check(CLI::NonNegativeNumber);
+  sub->footer("Exit status: 0 messages printed, 3 samples could not be decoded, 5 stdout could not be written, "
+              "6 nothing arrived.");
+  add_transport_options(*sub, cmd->transports);
+  return [cmd] { return cmd->run(); };
+}
+
+}  // namespace rvc::cli
