@@ -2,7 +2,9 @@
 
 #include <simdjson.h>
 
+#include <algorithm>
 #include <cmath>
+#include <charconv>
 #include <cstring>
 #include <limits>
 
@@ -56,15 +58,15 @@ class Reader {
     out_ += '{';
     bool first = true;
     for (const Field& f : type.fields) {
-      size_t path_size = path_.size();
-      if (!path_.empty()) path_ += '.';
-      path_ += f.name;
       if (!first) out_ += ',';
       first = false;
-      append_json_string(out_, f.name);
-      out_ += ':';
+      // Field names are identifiers (the .msg parser checks): no escaping needed.
+      out_ += '"';
+      out_ += f.name;
+      out_ += "\":";
+      push(&f.name, 0);
       if (!field(f.type)) return false;
-      path_.resize(path_size);
+      pop();
     }
     out_ += '}';
     return true;
@@ -82,8 +84,40 @@ class Reader {
   }
 
  private:
+  // The path of the field being read ("status.twist.linear.x", "points[2].x"),
+  // kept as a stack of parts and spelled out only for an error: building it as
+  // a string for every field cost more than decoding the sample.
+  struct PathPart {
+    const std::string* name;  // null: an array index
+    uint32_t index;
+  };
+  static constexpr size_t kMaxPath = 64;  // deeper parts are not named in errors
+  PathPart path_[kMaxPath];
+  size_t depth_ = 0;
+
+  void push(const std::string* name, uint32_t index) {
+    if (depth_ < kMaxPath) path_[depth_] = {name, index};
+    ++depth_;
+  }
+  void pop() { --depth_; }
+
+  std::string path() const {
+    std::string p;
+    for (size_t i = 0; i < std::min(depth_, kMaxPath); ++i) {
+      if (path_[i].name) {
+        if (!p.empty()) p += '.';
+        p += *path_[i].name;
+      } else {
+        p += '[' + std::to_string(path_[i].index) + ']';
+      }
+    }
+    if (depth_ > kMaxPath) p += "...";
+    return p;
+  }
+
   bool fail(const std::string& what) {
-    error_ = {what + (path_.empty() ? std::string() : " in field " + path_), pos_ + kHeader};
+    const std::string p = path();
+    error_ = {what + (p.empty() ? std::string() : " in field " + p), pos_ + kHeader};
     return false;
   }
 
@@ -116,7 +150,7 @@ class Reader {
   }
 
   bool string_value(uint32_t bound) {
-    uint32_t len;
+    uint32_t len = 0;
     if (!count(len, 1)) return false;
     if (len == 0) {  // some writers send an empty string as length 0, without the NUL
       out_ += "\"\"";
@@ -136,10 +170,11 @@ class Reader {
 
   template <typename T>
   bool integer() {
-    T v;
+    T v{};
     if (!read(v)) return false;
-    if constexpr (std::is_signed_v<T>) out_ += std::to_string(static_cast<int64_t>(v));
-    else out_ += std::to_string(static_cast<uint64_t>(v));
+    char buf[24];
+    auto [end, ec] = std::to_chars(buf, buf + sizeof buf, v);
+    out_.append(buf, end);
     return true;
   }
 
@@ -199,12 +234,11 @@ class Reader {
       }
     }
     out_ += '[';
-    size_t path_size = path_.size();
     for (uint32_t i = 0; i < n; ++i) {
       if (i) out_ += ',';
-      path_ += '[' + std::to_string(i) + ']';
+      push(nullptr, i);
       if (!scalar(t)) return false;
-      path_.resize(path_size);
+      pop();
     }
     out_ += ']';
     return true;
@@ -216,7 +250,6 @@ class Reader {
   bool swap_;
   std::string& out_;
   CdrError& error_;
-  std::string path_;
 };
 
 // ------------------------------------------------------------------ encoding
