@@ -262,5 +262,22 @@ TEST(Pipeline, FuzzFoundChunkSizeDoesNotChangeResults) {
   }
 }
 
+// Found by the 1-hour fuzz_jsonl run: a whitespace-only line longer than
+// --max-message-size was a rejected message to `rvc check` but, being blank, no
+// message at all to `rvc monitor --input file:`. Blank lines are no messages,
+// whatever their length, whatever the chunking.
+TEST(Pipeline, FuzzFoundLongBlankLineIsNoMessage) {
+  const std::string text = std::string("{\"x\":1}\n") + std::string(40, ' ') + "\n \t\r" +
+                           std::string(30, ' ') + "\r\n{\"x\":2}\n" + std::string(50, ' ');
+  PipelineOptions o = discrete_all();
+  o.max_message_size = 24;
+  const std::vector<engine::PropertySpec> props = {{"a", "{x > 1}"}};
+  for (size_t chunk : {1, 2, 5, 16, 17, 40, 1 << 20}) {
+    Result r = run(props, o, text, chunked(chunk, 24));
+    EXPECT_EQ(r.stats.accepted, 2u) << chunk;
+    EXPECT_EQ(r.stats.rejected, 0u) << chunk << "\n" << r.stderr_text;
+  }
+}
+
 }  // namespace
 }  // namespace rvc::runtime
