@@ -48,27 +48,40 @@ class Reader {
       : data_(reinterpret_cast<const unsigned char*>(sample.data()) + kHeader),
         size_(sample.size() - kHeader), swap_(little != kHostLittle), out_(out), error_(error) {}
 
-  bool message(const MessageType& type) {
+  // `select`: the fields to write (null: all). Unselected fields are read
+  // and checked with emit_ off.
+  bool message(const MessageType& type, const CdrSelection* select = nullptr) {
     if (type.fields.empty()) {  // an empty message is one uint8 on the wire
       uint8_t ignored;
       if (!read(ignored)) return false;
-      out_ += "{}";
+      put("{}");
       return true;
     }
-    out_ += '{';
+    put('{');
     bool first = true;
+    const bool emitting = emit_;
     for (const Field& f : type.fields) {
-      if (!first) out_ += ',';
-      first = false;
-      // Field names are identifiers (the .msg parser checks): no escaping needed.
-      out_ += '"';
-      out_ += f.name;
-      out_ += "\":";
+      const CdrSelection* below = nullptr;
+      if (emitting && select && !select->all()) {
+        below = select->find(f.name);
+        emit_ = below != nullptr;
+      }
+      if (emit_) {
+        if (!first) out_ += ',';
+        first = false;
+        // Field names are identifiers (the .msg parser checks): no escaping needed.
+        out_ += '"';
+        out_ += f.name;
+        out_ += "\":";
+      }
       push(&f.name, 0);
-      if (!field(f.type)) return false;
+      if (!(f.type.prim == Prim::Message && f.type.array == ArrayKind::None ? message(*f.type.message, below)
+                                                                             : field(f.type)))
+        return false;
       pop();
+      emit_ = emitting;
     }
-    out_ += '}';
+    put('}');
     return true;
   }
 
@@ -115,6 +128,13 @@ class Reader {
     return p;
   }
 
+  void put(char c) {
+    if (emit_) out_ += c;
+  }
+  void put(std::string_view text) {
+    if (emit_) out_ += text;
+  }
+
   bool fail(const std::string& what) {
     const std::string p = path();
     error_ = {what + (p.empty() ? std::string() : " in field " + p), pos_ + kHeader};
@@ -153,7 +173,7 @@ class Reader {
     uint32_t len = 0;
     if (!count(len, 1)) return false;
     if (len == 0) {  // some writers send an empty string as length 0, without the NUL
-      out_ += "\"\"";
+      put("\"\"");
       return true;
     }
     const char* s = reinterpret_cast<const char*>(data_ + pos_);
@@ -163,7 +183,7 @@ class Reader {
     if (bound && text.size() > bound)
       return fail("string of " + std::to_string(text.size()) + " bytes over its bound " + std::to_string(bound));
     if (!simdjson::validate_utf8(text.data(), text.size())) return fail("string that is not UTF-8");
-    append_json_string(out_, text);
+    if (emit_) append_json_string(out_, text);
     pos_ += len;
     return true;
   }
@@ -172,6 +192,7 @@ class Reader {
   bool integer() {
     T v{};
     if (!read(v)) return false;
+    if (!emit_) return true;
     char buf[24];
     auto [end, ec] = std::to_chars(buf, buf + sizeof buf, v);
     out_.append(buf, end);
@@ -187,7 +208,7 @@ class Reader {
           pos_ -= 1;
           return fail("bool holding " + std::to_string(v));
         }
-        out_ += v ? "true" : "false";
+        put(v ? "true" : "false");
         return true;
       }
       case Prim::Byte: case Prim::Char: case Prim::UInt8: return integer<uint8_t>();
@@ -201,13 +222,13 @@ class Reader {
       case Prim::Float32: {
         float v;
         if (!read(v)) return false;
-        append_float(out_, static_cast<double>(v));
+        if (emit_) append_float(out_, static_cast<double>(v));
         return true;
       }
       case Prim::Float64: {
         double v;
         if (!read(v)) return false;
-        append_float(out_, v);
+        if (emit_) append_float(out_, v);
         return true;
       }
       case Prim::String: return string_value(t.string_bound);
@@ -233,14 +254,14 @@ class Reader {
         return fail("sequence of " + std::to_string(n) + " elements over its bound " + std::to_string(t.array_size));
       }
     }
-    out_ += '[';
+    put('[');
     for (uint32_t i = 0; i < n; ++i) {
-      if (i) out_ += ',';
+      if (i) put(',');
       push(nullptr, i);
       if (!scalar(t)) return false;
       pop();
     }
-    out_ += ']';
+    put(']');
     return true;
   }
 
@@ -250,6 +271,7 @@ class Reader {
   bool swap_;
   std::string& out_;
   CdrError& error_;
+  bool emit_ = true;  // write what is read (off inside fields no one selected)
 };
 
 // ------------------------------------------------------------------ encoding
@@ -436,7 +458,31 @@ class Writer {
 
 }  // namespace
 
-bool cdr_to_json(const MessageType& type, std::string_view sample, std::string& out, CdrError& error) {
+void CdrSelection::add(const std::vector<std::string>& path) {
+  CdrSelection* node = this;
+  for (const std::string& name : path) {
+    if (node->all_) return;
+    CdrSelection* next = nullptr;
+    for (auto& [n, child] : node->children_)
+      if (n == name) next = &child;
+    if (!next) {
+      node->children_.emplace_back(name, CdrSelection());
+      next = &node->children_.back().second;
+    }
+    node = next;
+  }
+  node->all_ = true;  // the path ends here: all of it
+  node->children_.clear();
+}
+
+const CdrSelection* CdrSelection::find(const std::string& name) const {
+  for (const auto& [n, child] : children_)
+    if (n == name) return &child;
+  return nullptr;
+}
+
+bool cdr_to_json(const MessageType& type, std::string_view sample, std::string& out, CdrError& error,
+                 const CdrSelection* select) {
   if (sample.size() < kHeader) {
     error = {"sample of " + std::to_string(sample.size()) + " bytes has no 4-byte CDR header", 0};
     return false;
@@ -452,7 +498,7 @@ bool cdr_to_json(const MessageType& type, std::string_view sample, std::string& 
     return false;
   }
   Reader r(sample, b1 == 1, out, error);
-  return r.message(type) && r.finish();
+  return r.message(type, select) && r.finish();
 }
 
 bool json_to_cdr(const MessageType& type, std::string_view json, std::string& sample, std::string& error,

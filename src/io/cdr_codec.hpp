@@ -13,6 +13,8 @@
 #include <cstdint>
 #include <string>
 #include <string_view>
+#include <utility>
+#include <vector>
 
 #include "msg/msg_types.hpp"
 
@@ -26,11 +28,32 @@ struct CdrError {
   std::string to_string() const { return message + " at byte " + std::to_string(offset); }
 };
 
+// The fields of a sample worth writing as JSON: the paths properties read
+// ({status.twist.linear.x > 1} selects status.twist.linear.x). A path that
+// ends at a nested message selects all of it. Fields outside the selection
+// are still read and checked (a bad sample is refused whatever is selected),
+// only not written: formatting numbers the properties never look at was most
+// of the typed input's cost.
+class CdrSelection {
+ public:
+  void add(const std::vector<std::string>& path);
+  void add_all() { all_ = true; }
+  bool all() const { return all_; }
+  // The selection below field `name`, or null if nothing there is selected.
+  const CdrSelection* find(const std::string& name) const;
+
+ private:
+  bool all_ = false;
+  std::vector<std::pair<std::string, CdrSelection>> children_;
+};
+
 // Appends the sample as one JSON object (fields in definition order, numbers
-// exact: float32 values widened to double, 64-bit integers in full) to `out`.
-// Returns false with `error` for a malformed or truncated sample; `out` then
-// holds a partial object the caller discards.
-bool cdr_to_json(const msg::MessageType& type, std::string_view sample, std::string& out, CdrError& error);
+// exact: float32 values widened to double, 64-bit integers in full) to `out`;
+// with `select`, only the selected fields. Returns false with `error` for a
+// malformed or truncated sample; `out` then holds a partial object the caller
+// discards.
+bool cdr_to_json(const msg::MessageType& type, std::string_view sample, std::string& out, CdrError& error,
+                 const CdrSelection* select = nullptr);
 
 struct CdrWriteOptions {
   bool big_endian = false;

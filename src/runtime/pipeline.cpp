@@ -40,7 +40,12 @@ Pipeline::Pipeline(const std::vector<engine::PropertySpec>& properties, const Pi
       options_(options),
       decoder_(checker_.atoms(), io::DecoderOptions{options.model == engine::TimeModel::Dense, options.time_field,
                                                     options.strict}),
-      batch_reader_(*this, options.max_message_size) {}
+      batch_reader_(*this, options.max_message_size) {
+  if (options_.type) {  // typed input: write only what the properties read (and the time)
+    for (const auto& t : checker_.atoms().tests()) typed_selection_.add(t.path);
+    if (options_.model == engine::TimeModel::Dense) typed_selection_.add({options_.time_field});
+  }
+}
 
 void Pipeline::report(const std::string& text) {
   if (reported_++ < options_.max_reported) std::fprintf(stderr, "rvc: %s\n", text.c_str());
@@ -128,7 +133,7 @@ void Pipeline::feed(std::string_view payload, uint64_t position) {
     if (oversized(payload, position)) return;
     typed_json_.clear();
     io::CdrError error;
-    if (!io::cdr_to_json(*options_.type, payload, typed_json_, error)) {
+    if (!io::cdr_to_json(*options_.type, payload, typed_json_, error, &typed_selection_)) {
       on_error(io::LineError{position, 0, "bad " + options_.type->full_name() + " sample: " + error.to_string()});
       return;
     }

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "engine/checker.hpp"
+#include "io/cdr_codec.hpp"
 #include "io/json_decoder.hpp"
 #include "io/jsonl_reader.hpp"
 #include "msg/msg_types.hpp"
@@ -86,6 +87,7 @@ class Pipeline final : public io::JsonlHandler {
   simdjson::ondemand::parser parser_;
   std::string scratch_;
   std::string typed_json_;  // a CDR sample decoded to JSON
+  io::CdrSelection typed_selection_;  // the fields of a CDR sample the properties read
   io::ChunkReader batch_reader_;
   uint64_t batch_position_ = 0;  // position of the payload being read as a batch, else 0
 };
