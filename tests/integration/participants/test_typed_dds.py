@@ -258,3 +258,36 @@ def test_typed_replay_to_monitor_with_constants(rvc, tmp_path, types):
     finally:
         if mon.poll() is None:
             mon.kill()
+
+
+def test_typed_bridge_dds_to_zenoh(rvc, tmp_path, types):
+    """rvc bridge --type: a typed DDS topic forwarded to Zenoh as CDR payloads (what
+    zenoh-bridge-ros2dds does), echoed from Zenoh with the values replayed into DDS."""
+    if "zenoh" not in transports_built(rvc):
+        pytest.skip("rvc built without Zenoh")
+    from test_python_peers import free_port
+    domain = 100 + os.getpid() % 20
+    rng = random.Random(9)
+    values = [random_mixed(rng, i) for i in range(25)]
+    trace = tmp_path / "mixed.jsonl"
+    trace.write_text("".join(json.dumps(v) + "\n" for v in values))
+    typed = ["--type", MIXED, "--msg-path", MSGS]
+    ep = f"tcp/127.0.0.1:{free_port()}"
+    zenoh = ["--no-multicast-scouting"]
+    echo = subprocess.Popen([rvc, "echo", "zenoh:rvc_typed/bridged", *typed, "--idle-timeout", "3", "--listen", ep,
+                             *zenoh], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    bridge = subprocess.Popen([rvc, "bridge", "dds:/rvc_typed/bridged", "zenoh:rvc_typed/bridged", *typed,
+                               "--domain", str(domain), "--connect", ep, *zenoh],
+                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        rep = subprocess.run([rvc, "replay", str(trace), "--to", "dds:/rvc_typed/bridged", *typed, "--domain",
+                              str(domain), "--no-progress", "--wait-timeout", "30"],
+                             capture_output=True, text=True, timeout=HANG_GUARD)
+        assert rep.returncode == 0, rep.stderr
+        out, err = echo.communicate(timeout=HANG_GUARD)
+        assert echo.returncode == 0, err
+        assert [json.loads(l) for l in out.splitlines()] == values
+    finally:
+        for p in (echo, bridge):
+            if p.poll() is None:
+                p.kill()
