@@ -33,7 +33,8 @@ run_asan() {
   ASAN_OPTIONS=${ASAN_OPTIONS/detect_leaks=1/detect_leaks=0} RVC_BIN=$bin/rvc "${PYTEST[@]}" \
     "tests/integration/participants/test_publishers.py::test_two_publishers_on_one_topic[dds]" \
     "tests/integration/participants/test_publishers.py::test_publisher_run_again_is_a_restart[dds]" \
-    tests/integration/participants/test_monitor_ending.py tests/integration/participants/test_typed_dds.py
+    tests/integration/participants/test_monitor_ending.py tests/integration/participants/test_typed_dds.py \
+    --deselect tests/integration/participants/test_typed_dds.py::test_typed_bridge_dds_to_zenoh  # needs Zenoh
 }
 
 run_tsan() {
