@@ -26,6 +26,7 @@ struct MonitorCommand {
   std::vector<std::string> outputs;
   std::string stats_output;
   bool exit_on_eos = false;
+  size_t publishers = 1;  // --publishers: end-of-stream markers to wait for
   double idle_timeout = 0;
   double stats_interval = 0;
   size_t queue_capacity = 1 << 14;
@@ -95,6 +96,7 @@ struct MonitorCommand {
     // A file has nothing more to come after its end.
     const bool from_file = transport::scheme_of(input) == "file";
     lopts.exit_on_eos = exit_on_eos || from_file;
+    lopts.publishers = publishers;
     lopts.sequence_numbers = !from_file;
     lopts.idle_timeout = idle_timeout;
     lopts.stats_interval = stats_interval;
@@ -123,6 +125,11 @@ Runner register_monitor(CLI::App& app) {
       ->allow_extra_args(false);
   sub->add_flag("--exit-on-eos", cmd->exit_on_eos,
                 "Exit after the publisher's end-of-stream marker (ending any other way is then exit 6)");
+  sub->add_option("--publishers", cmd->publishers,
+                  "With --exit-on-eos: wait for the end-of-stream markers of at least N publishers (and of every "
+                  "publisher seen)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   sub->add_option("--idle-timeout", cmd->idle_timeout,
                   "Give up after S seconds without any message (0: wait forever); with --exit-on-eos that is exit 6")
       ->check(CLI::NonNegativeNumber);

@@ -108,7 +108,8 @@ void MonitorLoop::process(transport::Source& source) {
         if (f.eos) {
           // Several publishers: the stream ends when each has ended.
           if (options_.sequence_numbers) counters_.on_eos(f.seq, f.publisher);
-          eos_ = !options_.sequence_numbers || counters_.all_ended();
+          eos_ = !options_.sequence_numbers ||
+                 (counters_.all_ended() && counters_.publishers() >= options_.publishers);
           continue;
         }
         std::string_view payload = f.payload;

@@ -24,6 +24,10 @@ namespace rvc::runtime {
 struct LoopOptions {
   std::string input;             // the input's name in the counters line
   bool exit_on_eos = false;      // stop at the publisher's end-of-stream marker
+  // With exit_on_eos: how many publishers' markers end the stream. A publisher
+  // the monitor has not discovered yet when the others end cannot be waited
+  // for otherwise (discovery is asynchronous on both DDS and Zenoh).
+  size_t publishers = 1;
   double idle_timeout = 0;       // seconds without any message before giving up; 0: wait forever
   double stats_interval = 0;     // seconds between counter lines; 0: only on request
   size_t queue_capacity = 1 << 14;

@@ -38,8 +38,10 @@ def write_trace(tmp_path, name, n):
 @pytest.mark.parametrize("transport", ["dds", "zenoh"])
 def test_two_publishers_on_one_topic(rvc, tmp_path, transport):
     topic, flags = net(rvc, transport)
-    mon = subprocess.Popen([rvc, "monitor", "--spec", "{p}", "--input", topic, "--exit-on-eos", "--idle-timeout",
-                            "60", "--output", f"file:{tmp_path / 'v'}", *flags], stderr=subprocess.PIPE, text=True)
+    # --publishers 2: the second replay may be discovered only after the first
+    # has ended (seen in CI under ASan); without it the run ends at the first marker.
+    mon = subprocess.Popen([rvc, "monitor", "--spec", "{p}", "--input", topic, "--exit-on-eos", "--publishers", "2",
+                            "--idle-timeout", "60", "--output", f"file:{tmp_path / 'v'}", *flags], stderr=subprocess.PIPE, text=True)
     reps = [subprocess.Popen([rvc, "replay", write_trace(tmp_path, f"t{i}.jsonl", 300 + i), "--to", topic,
                               "--rate", "3000", "--wait-timeout", "20", *flags],
                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) for i in range(2)]
@@ -70,3 +72,20 @@ def test_publisher_run_again_is_a_restart(rvc, tmp_path, transport):
     s = final_stats(err)
     assert (s["received"], s["gaps"], s["duplicates"], s["publisher_restarts"]) == (100, 0, 0, 1), err
     assert mon.returncode == 0, err  # not 4 (lost): the restart is reported, nothing was lost
+
+
+def test_publishers_flag_waits_for_the_others(rvc, tmp_path):
+    """One publisher ended, two expected: the run is not over at its marker;
+    the idle timeout then ends it as incomplete (exit 6), every message checked."""
+    topic, flags = net(rvc, "dds")
+    mon = subprocess.Popen([rvc, "monitor", "--spec", "{p}", "--input", topic, "--exit-on-eos", "--publishers", "2",
+                            "--idle-timeout", "3", "--output", f"file:{tmp_path / 'v'}", *flags],
+                           stderr=subprocess.PIPE, text=True)
+    r = subprocess.run([rvc, "replay", write_trace(tmp_path, "t.jsonl", 40), "--to", topic, "--wait-timeout", "20",
+                        *flags], capture_output=True, text=True, timeout=60)
+    assert r.returncode == 0, r.stderr
+    _, err = mon.communicate(timeout=60)
+    s = final_stats(err)
+    assert (s["received"], s["checked"], s["publishers"]) == (40, 40, 1), err
+    assert "before the publisher's end-of-stream marker" in err
+    assert mon.returncode == 6, err
