@@ -2,8 +2,8 @@
 // ROS 2 CDR compared with the same message as JSON, on two of the paper's
 // Table-3 types. Side by side in one run, same properties, same values:
 //   json   Pipeline::feed(JSON payload)             (rvc's JSON path)
-//   typed  Pipeline::feed(CDR payload), --type T   (CDR -> JSON -> same path)
-//   decode cdr_to_json alone                        (the typed path's extra step)
+//   typed  Pipeline::feed(CDR payload), --type T   (CDR straight into the tests' values)
+//   decode cdr_to_json alone                        (what `rvc echo` pays per sample)
 // Prints a markdown table (ns per message, typed/json ratio) and writes it as
 // JSON lines to the file given as argument (default bench/results/cdr.jsonl).
 //   build/release/rvc_cdr_bench [OUT]

@@ -30,7 +30,38 @@ struct EchoCommand {
   std::vector<std::string> msg_paths;
   uint64_t count = 0;        // 0: no limit
   double idle_timeout = 0;   // 0: none
+  std::vector<std::string> fields;  // --field: only these paths of a typed sample
   msg::TypeRegistry registry;
+
+  // --field a.b.c: each part a field of the message the previous one names.
+  static bool select(const msg::MessageType& type, const std::string& path, io::CdrSelection& selection) {
+    std::vector<std::string> parts;
+    size_t start = 0;
+    for (size_t dot; (dot = path.find('.', start)) != std::string::npos; start = dot + 1)
+      parts.push_back(path.substr(start, dot - start));
+    parts.push_back(path.substr(start));
+    const msg::MessageType* holder = &type;
+    for (const auto& part : parts) {
+      const msg::Field* found = nullptr;
+      if (holder)
+        for (const auto& f : holder->fields)
+          if (f.name == part) found = &f;
+      if (!found) {
+        std::string names;
+        if (holder)
+          for (const auto& f : holder->fields) names += (names.empty() ? "" : ", ") + f.name;
+        std::fprintf(stderr, "rvc: --field %s: no field '%s' in %s%s%s\n", path.c_str(), part.c_str(),
+                     holder ? holder->full_name().c_str() : "a field that is no message",
+                     holder ? "; its fields: " : "", names.c_str());
+        return false;
+      }
+      holder = found->type.prim == msg::Prim::Message && found->type.array == msg::ArrayKind::None
+                   ? found->type.message
+                   : nullptr;
+    }
+    selection.add(parts);
+    return true;
+  }
 
   int run() {
     const msg::MessageType* ros_type = nullptr;
@@ -46,6 +77,13 @@ struct EchoCommand {
       transports.dds.ros_type = ros_type;
 #endif
     }
+    io::CdrSelection selection;
+    if (!fields.empty() && !ros_type) {
+      std::fprintf(stderr, "rvc: --field selects fields of typed samples: give --type too\n");
+      return kUsage;
+    }
+    for (const auto& path : fields)
+      if (!select(*ros_type, path, selection)) return kUsage;
     transport::FrameQueue queue(1024);
     auto source = transport::open_source(input, transports);
     install_stop_signals();
@@ -75,7 +113,7 @@ struct EchoCommand {
         if (ros_type) {
           io::CdrError error;
           json.clear();  // cdr_to_json appends
-          if (!io::cdr_to_json(*ros_type, f.payload, json, error)) {
+          if (!io::cdr_to_json(*ros_type, f.payload, json, error, fields.empty() ? nullptr : &selection)) {
             if (++rejected <= 100)
               std::fprintf(stderr, "rvc: sample %llu: not a %s: %s (skipped)\n", static_cast<unsigned long long>(f.seq),
                            ros_type->full_name().c_str(), error.to_string().c_str());
@@ -116,6 +154,9 @@ Runner register_echo(CLI::App& app) {
   sub->add_option("--type", cmd->type, "ROS 2 message type of the samples, pkg/msg/Name (`rvc msg list`)");
   sub->add_option("--msg-path", cmd->msg_paths,
                   "Folder of .msg definitions for --type: a ROS 2 share/ tree or a plain folder (repeatable)");
+  sub->add_option("--field", cmd->fields,
+                  "Print only this field of each typed sample, e.g. status.twist (repeatable; the rest is still "
+                  "checked)");
   sub->add_option("--count,-n", cmd->count, "Stop after this many messages (default: no limit)");
   sub->add_option("--idle-timeout", cmd->idle_timeout, "Stop after this many seconds without a message")
       ->check(CLI::NonNegativeNumber);

@@ -8,6 +8,7 @@
 #include <cstring>
 #include <limits>
 
+#include "io/cdr_cursor.hpp"
 #include "io/json_writer.hpp"
 
 namespace rvc::io {
@@ -44,16 +45,14 @@ void append_float(std::string& out, double v) {
 
 class Reader {
  public:
-  Reader(std::string_view sample, bool little, std::string& out, CdrError& error)
-      : data_(reinterpret_cast<const unsigned char*>(sample.data()) + kHeader),
-        size_(sample.size() - kHeader), swap_(little != kHostLittle), out_(out), error_(error) {}
+  Reader(std::string& out, CdrCursor& in) : in_(in), out_(out) {}
 
   // `select`: the fields to write (null: all). Unselected fields are read
   // and checked with emit_ off.
   bool message(const MessageType& type, const CdrSelection* select = nullptr) {
     if (type.fields.empty()) {  // an empty message is one uint8 on the wire
       uint8_t ignored;
-      if (!read(ignored)) return false;
+      if (!in_.read(ignored)) return false;
       put("{}");
       return true;
     }
@@ -74,60 +73,18 @@ class Reader {
         out_ += f.name;
         out_ += "\":";
       }
-      push(&f.name, 0);
+      in_.push(&f.name);
       if (!(f.type.prim == Prim::Message && f.type.array == ArrayKind::None ? message(*f.type.message, below)
                                                                              : field(f.type)))
         return false;
-      pop();
+      in_.pop();
       emit_ = emitting;
     }
     put('}');
     return true;
   }
 
-  // After the last field: only padding (at most 3 bytes, to a 4-byte boundary) may remain.
-  bool finish() {
-    size_t rest = size_ - pos_;
-    if (rest > 3) {
-      error_ = {std::to_string(rest) + " bytes left over after the last field (a sample of another type?)",
-                pos_ + kHeader};
-      return false;
-    }
-    return true;
-  }
-
  private:
-  // The path of the field being read ("status.twist.linear.x", "points[2].x"),
-  // kept as a stack of parts and spelled out only for an error: building it as
-  // a string for every field cost more than decoding the sample.
-  struct PathPart {
-    const std::string* name;  // null: an array index
-    uint32_t index;
-  };
-  static constexpr size_t kMaxPath = 64;  // deeper parts are not named in errors
-  PathPart path_[kMaxPath];
-  size_t depth_ = 0;
-
-  void push(const std::string* name, uint32_t index) {
-    if (depth_ < kMaxPath) path_[depth_] = {name, index};
-    ++depth_;
-  }
-  void pop() { --depth_; }
-
-  std::string path() const {
-    std::string p;
-    for (size_t i = 0; i < std::min(depth_, kMaxPath); ++i) {
-      if (path_[i].name) {
-        if (!p.empty()) p += '.';
-        p += *path_[i].name;
-      } else {
-        p += '[' + std::to_string(path_[i].index) + ']';
-      }
-    }
-    if (depth_ > kMaxPath) p += "...";
-    return p;
-  }
-
   void put(char c) {
     if (emit_) out_ += c;
   }
@@ -135,63 +92,10 @@ class Reader {
     if (emit_) out_ += text;
   }
 
-  bool fail(const std::string& what) {
-    const std::string p = path();
-    error_ = {what + (p.empty() ? std::string() : " in field " + p), pos_ + kHeader};
-    return false;
-  }
-
-  bool align(size_t n) {
-    size_t p = (pos_ + n - 1) & ~(n - 1);
-    if (p > size_) return fail("truncated sample");
-    pos_ = p;
-    return true;
-  }
-
-  template <typename T>
-  bool read(T& v) {
-    if (!align(sizeof(T))) return false;
-    if (size_ - pos_ < sizeof(T)) return fail("truncated sample");
-    std::memcpy(&v, data_ + pos_, sizeof(T));
-    if (swap_ && sizeof(T) > 1) v = byteswap(v);
-    pos_ += sizeof(T);
-    return true;
-  }
-
-  bool count(uint32_t& n, size_t min_element_size) {
-    if (!read(n)) return false;
-    // every element takes at least min_element_size bytes: a count the rest
-    // of the sample cannot hold is refused before any element is read
-    if (min_element_size && n > (size_ - pos_) / min_element_size) {
-      pos_ -= 4;
-      return fail("sequence length " + std::to_string(n) + " exceeds the sample");
-    }
-    return true;
-  }
-
-  bool string_value(uint32_t bound) {
-    uint32_t len = 0;
-    if (!count(len, 1)) return false;
-    if (len == 0) {  // some writers send an empty string as length 0, without the NUL
-      put("\"\"");
-      return true;
-    }
-    const char* s = reinterpret_cast<const char*>(data_ + pos_);
-    if (s[len - 1] != '\0') return fail("string without its terminating NUL");
-    std::string_view text(s, len - 1);
-    if (text.find('\0') != std::string_view::npos) return fail("string with a NUL inside");
-    if (bound && text.size() > bound)
-      return fail("string of " + std::to_string(text.size()) + " bytes over its bound " + std::to_string(bound));
-    if (!simdjson::validate_utf8(text.data(), text.size())) return fail("string that is not UTF-8");
-    if (emit_) append_json_string(out_, text);
-    pos_ += len;
-    return true;
-  }
-
   template <typename T>
   bool integer() {
     T v{};
-    if (!read(v)) return false;
+    if (!in_.read(v)) return false;
     if (!emit_) return true;
     char buf[24];
     auto [end, ec] = std::to_chars(buf, buf + sizeof buf, v);
@@ -202,12 +106,8 @@ class Reader {
   bool scalar(const FieldType& t) {
     switch (t.prim) {
       case Prim::Bool: {
-        uint8_t v;
-        if (!read(v)) return false;
-        if (v > 1) {
-          pos_ -= 1;
-          return fail("bool holding " + std::to_string(v));
-        }
+        bool v;
+        if (!in_.boolean(v)) return false;
         put(v ? "true" : "false");
         return true;
       }
@@ -221,56 +121,46 @@ class Reader {
       case Prim::UInt64: return integer<uint64_t>();
       case Prim::Float32: {
         float v;
-        if (!read(v)) return false;
+        if (!in_.read(v)) return false;
         if (emit_) append_float(out_, static_cast<double>(v));
         return true;
       }
       case Prim::Float64: {
         double v;
-        if (!read(v)) return false;
+        if (!in_.read(v)) return false;
         if (emit_) append_float(out_, v);
         return true;
       }
-      case Prim::String: return string_value(t.string_bound);
-      case Prim::WString: return fail("wstring fields are not supported");
+      case Prim::String: {
+        std::string_view text;
+        if (!in_.string(text, t.string_bound)) return false;
+        if (emit_) append_json_string(out_, text);
+        return true;
+      }
+      case Prim::WString: return in_.fail("wstring fields are not supported");
       case Prim::Message: return message(*t.message);
     }
-    return fail("unknown type");
-  }
-
-  static size_t min_size(const FieldType& t) {
-    if (t.prim == Prim::String || t.prim == Prim::WString) return 4;
-    if (t.prim == Prim::Message) return 1;
-    return msg::prim_size(t.prim);
+    return in_.fail("unknown type");
   }
 
   bool field(const FieldType& t) {
     if (t.array == ArrayKind::None) return scalar(t);
     uint32_t n = t.array_size;
-    if (t.array != ArrayKind::Fixed) {
-      if (!count(n, min_size(t))) return false;
-      if (t.array == ArrayKind::Bounded && n > t.array_size) {
-        pos_ -= 4;
-        return fail("sequence of " + std::to_string(n) + " elements over its bound " + std::to_string(t.array_size));
-      }
-    }
+    if (t.array == ArrayKind::Unbounded && !in_.count(n, cdr_min_size(t))) return false;
+    if (t.array == ArrayKind::Bounded && !in_.count(n, cdr_min_size(t), t.array_size)) return false;
     put('[');
     for (uint32_t i = 0; i < n; ++i) {
       if (i) put(',');
-      push(nullptr, i);
+      in_.push_index(i);
       if (!scalar(t)) return false;
-      pop();
+      in_.pop();
     }
     put(']');
     return true;
   }
 
-  const unsigned char* data_;
-  size_t size_;
-  size_t pos_ = 0;
-  bool swap_;
+  CdrCursor& in_;
   std::string& out_;
-  CdrError& error_;
   bool emit_ = true;  // write what is read (off inside fields no one selected)
 };
 
@@ -483,22 +373,10 @@ const CdrSelection* CdrSelection::find(const std::string& name) const {
 
 bool cdr_to_json(const MessageType& type, std::string_view sample, std::string& out, CdrError& error,
                  const CdrSelection* select) {
-  if (sample.size() < kHeader) {
-    error = {"sample of " + std::to_string(sample.size()) + " bytes has no 4-byte CDR header", 0};
-    return false;
-  }
-  auto b0 = static_cast<unsigned char>(sample[0]), b1 = static_cast<unsigned char>(sample[1]);
-  if (b0 != 0 || b1 > 1) {
-    const char* what = b0 == 0 && (b1 == 2 || b1 == 3)   ? " (parameter-list CDR)"
-                       : b0 == 0 && b1 >= 6 && b1 <= 11 ? " (XCDR2, not ROS 2's plain CDR)"
-                                                        : "";
-    error = {"unsupported CDR representation 0x" + std::string(1, "0123456789abcdef"[b0 >> 4]) +
-                 "0123456789abcdef"[b0 & 15] + "0123456789abcdef"[b1 >> 4] + "0123456789abcdef"[b1 & 15] + what,
-             0};
-    return false;
-  }
-  Reader r(sample, b1 == 1, out, error);
-  return r.message(type, select) && r.finish();
+  CdrCursor in(error);
+  if (!in.open(sample)) return false;
+  Reader r(out, in);
+  return r.message(type, select) && in.finish();
 }
 
 bool json_to_cdr(const MessageType& type, std::string_view json, std::string& sample, std::string& error,

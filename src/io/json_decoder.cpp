@@ -1,6 +1,10 @@
 #include "io/json_decoder.hpp"
 
+#include <algorithm>
+
 #include <cstring>
+
+#include "io/field_tests.hpp"
 
 namespace rvc::io {
 
@@ -9,27 +13,19 @@ using FOp = spec::FieldTest::Op;
 
 namespace {
 
-const char* type_name(json_type t) {
+ValueKind kind_of(json_type t) {
   switch (t) {
-    case json_type::array: return "an array";
-    case json_type::object: return "an object";
-    case json_type::number: return "a number";
-    case json_type::string: return "a string";
-    case json_type::boolean: return "a Boolean";
-    case json_type::null: return "null";
+    case json_type::array: return ValueKind::Array;
+    case json_type::object: return ValueKind::Object;
+    case json_type::number: return ValueKind::Number;
+    case json_type::string: return ValueKind::String;
+    case json_type::boolean: return ValueKind::Bool;
+    case json_type::null: return ValueKind::Null;
   }
-  return "a value";
+  return ValueKind::Null;
 }
 
-const char* expected_for(const spec::FieldTest& t) {
-  if (t.op == FOp::Truthy) return "a Boolean or number";
-  switch (t.value.kind) {
-    case spec::Literal::Kind::Bool: return "a Boolean";
-    case spec::Literal::Kind::Number: return "a number";
-    case spec::Literal::Kind::String: return "a string";
-  }
-  return "a value";
-}
+const char* type_name(json_type t) { return value_kind_name(kind_of(t)); }
 
 // Length of a raw key: the bytes before its closing quote. A backslash
 // escapes the byte after it, so `\\"` (an escaped backslash, then the quote)
@@ -206,7 +202,7 @@ JsonDecoder::KeyNode* JsonDecoder::child(KeyNode& parent, const std::string& nam
 }
 
 bool JsonDecoder::decode(simdjson::ondemand::object object, std::string& error, std::vector<std::string>* warnings) {
-  std::memcpy(next_.data(), current_.data(), current_.size());
+  std::copy(current_.begin(), current_.end(), next_.begin());  // (memcpy of no atoms: null pointers)
   for (int id : presence_tests_) next_[id] = 0;
   saw_time_ = false;
   malformed_ = false;
@@ -329,39 +325,16 @@ bool JsonDecoder::apply_tests(KeyNode& node, simdjson::ondemand::value value, js
     malformed_ = true;
     return false;
   }
+  const FieldValue v{kind_of(type), b, d, s};
   for (int id : node.tests) {
     const spec::FieldTest& t = atoms_.tests()[id];
-    int result = -1;  // -1: wrong type, the test keeps its previous value
-    const auto lit = t.value.kind;
-    switch (t.op) {
-      case FOp::Present:
-      case FOp::Bind: result = 1; break;
-      case FOp::Truthy:
-        if (type == json_type::boolean) result = b;
-        else if (type == json_type::number) result = d != 0;
-        else if (type == json_type::null) result = 0;  // Reelay reads null as false
-        break;
-      case FOp::Eq:
-      case FOp::Ne: {
-        int eq = -1;
-        if (lit == spec::Literal::Kind::Bool && type == json_type::boolean) eq = b == t.value.b;
-        else if (lit == spec::Literal::Kind::Number && type == json_type::number) eq = d == t.value.number;
-        else if (lit == spec::Literal::Kind::String && type == json_type::string) eq = s == t.value.text;
-        if (eq >= 0) result = t.op == FOp::Eq ? eq : !eq;
-        break;
-      }
-      case FOp::Lt: if (type == json_type::number) result = d < t.value.number; break;
-      case FOp::Le: if (type == json_type::number) result = d <= t.value.number; break;
-      case FOp::Gt: if (type == json_type::number) result = d > t.value.number; break;
-      case FOp::Ge: if (type == json_type::number) result = d >= t.value.number; break;
-    }
+    const int result = evaluate_test(t, v);  // -1: wrong type, the test keeps its previous value
     if (result >= 0) {
       next_[id] = static_cast<uint8_t>(result);
       continue;
     }
     if (type == json_type::null && !options_.strict) continue;  // null: no value, like a missing field
-    std::string problem = "field \"" + t.key() + "\" is " + type_name(type) + ", but {" + t.to_string() + "} needs " +
-                          expected_for(t);
+    std::string problem = wrong_type_problem(t, v.kind);
     if (options_.strict) {
       error = problem;
       return false;

@@ -26,6 +26,14 @@ engine::Checker build(const std::vector<engine::PropertySpec>& properties, const
   return checker;
 }
 
+// Typed dense time keeps the default "time" only if the type has it; else
+// the message's stamp (header.stamp, stamp), as ROS 2 users expect.
+PipelineOptions with_defaults(PipelineOptions o) {
+  if (o.type && o.model == engine::TimeModel::Dense)
+    o.time_field = io::CdrDecoder::default_time_field(*o.type, o.time_field);
+  return o;
+}
+
 std::string number(double v) {
   std::string s;
   io::append_number(s, v);
@@ -36,14 +44,14 @@ std::string number(double v) {
 
 Pipeline::Pipeline(const std::vector<engine::PropertySpec>& properties, const PipelineOptions& options,
                    engine::VerdictCallback on_verdict)
-    : checker_(build(properties, options, std::move(on_verdict))),
-      options_(options),
+    : checker_(build(properties, with_defaults(options), std::move(on_verdict))),
+      options_(with_defaults(options)),
       decoder_(checker_.atoms(), io::DecoderOptions{options.model == engine::TimeModel::Dense, options.time_field,
                                                     options.strict}),
       batch_reader_(*this, options.max_message_size) {
-  if (options_.type) {  // typed input: write only what the properties read (and the time)
-    for (const auto& t : checker_.atoms().tests()) typed_selection_.add(t.path);
-    if (options_.model == engine::TimeModel::Dense) typed_selection_.add({options_.time_field});
+  if (options_.type) {
+    typed_.emplace(checker_.atoms(), *options_.type,
+                   io::DecoderOptions{options.model == engine::TimeModel::Dense, options_.time_field, options.strict});
   }
 }
 
@@ -96,13 +104,13 @@ void Pipeline::commit() {
     report("warning: " + options_.position_name + " " + std::to_string(pending_where_->number()) + ": " + w);
   }
   if (options_.parse_only) {
-    decoder_.commit();
+    commit_values();
   } else if (checker_.model() == engine::TimeModel::Discrete) {
-    decoder_.commit();
-    checker_.step(decoder_.values());
+    commit_values();
+    checker_.step(values());
   } else {
     // Dense: this message closes [previous time, its time) with the previous values.
-    double t = decoder_.time();
+    double t = message_time();
     double begin = has_time_ ? last_time_ : 0;
     if (!(t >= 0) || (has_time_ && !(t > last_time_))) {
       std::string why = t < 0 ? "time " + number(t) + " is negative (the timeline starts at 0)"
@@ -111,8 +119,8 @@ void Pipeline::commit() {
       on_error(io::LineError{pending_where_->number(), 0, why});
       return;
     }
-    checker_.step(begin, t, decoder_.values());
-    decoder_.commit();
+    checker_.step(begin, t, values());
+    commit_values();
     has_time_ = true;
     last_time_ = t;
   }
@@ -129,15 +137,8 @@ bool Pipeline::oversized(std::string_view payload, uint64_t position) {
 }
 
 void Pipeline::feed(std::string_view payload, uint64_t position) {
-  if (options_.type) {  // one CDR sample per payload (never a batch)
-    if (oversized(payload, position)) return;
-    typed_json_.clear();
-    io::CdrError error;
-    if (!io::cdr_to_json(*options_.type, payload, typed_json_, error, &typed_selection_)) {
-      on_error(io::LineError{position, 0, "bad " + options_.type->full_name() + " sample: " + error.to_string()});
-      return;
-    }
-    io::parse_one(parser_, typed_json_, position, *this, scratch_);
+  if (typed_) {  // one CDR sample per payload (never a batch)
+    if (!oversized(payload, position)) feed_typed(payload, position);
     return;
   }
   if (payload.find('\n') != std::string_view::npos) {
@@ -149,6 +150,18 @@ void Pipeline::feed(std::string_view payload, uint64_t position) {
   }
   if (oversized(payload, position)) return;
   io::parse_one(parser_, payload, position, *this, scratch_);
+}
+
+void Pipeline::feed_typed(std::string_view sample, uint64_t position) {
+  std::string error;
+  warnings_.clear();
+  if (!typed_->decode(sample, error, &warnings_)) {
+    on_error(io::LineError{position, 0, error});
+    return;
+  }
+  pending_ = true;
+  pending_where_.emplace(position);
+  commit();
 }
 
 void Pipeline::finish_report() {

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "engine/checker.hpp"
-#include "io/cdr_codec.hpp"
+#include "io/cdr_decoder.hpp"
 #include "io/json_decoder.hpp"
 #include "io/jsonl_reader.hpp"
 #include "msg/msg_types.hpp"
@@ -29,9 +29,9 @@ struct PipelineOptions {
   size_t max_reported = 100;           // errors and warnings printed before going quiet
   bool parse_only = false;             // decode every message but run no monitor (benchmark floor)
   size_t max_message_size = 1 << 20;   // longest message: a line, a payload, a line inside a batched payload
-  // Typed input (--type): each payload is one CDR sample of this type, decoded
-  // to JSON before the usual path (properties are checked against the type
-  // first). Owned by the caller's msg::TypeRegistry; null: JSON payloads.
+  // Typed input (--type): each payload is one CDR sample of this type,
+  // decoded straight into the tests' values (properties are checked against
+  // the type first). Owned by the caller's msg::TypeRegistry; null: JSON.
   const msg::MessageType* type = nullptr;
 };
 
@@ -70,6 +70,11 @@ class Pipeline final : public io::JsonlHandler {
  private:
   void report(const std::string& text);
   bool oversized(std::string_view payload, uint64_t position);  // rejects it if so
+  void feed_typed(std::string_view sample, uint64_t position);
+  // The decoder of the message being committed.
+  void commit_values() { typed_ ? typed_->commit() : decoder_.commit(); }
+  const uint8_t* values() const { return typed_ ? typed_->values() : decoder_.values(); }
+  double message_time() const { return typed_ ? typed_->time() : decoder_.time(); }
   engine::Checker checker_;
   PipelineOptions options_;
   io::JsonDecoder decoder_;
@@ -86,8 +91,7 @@ class Pipeline final : public io::JsonlHandler {
   std::string json_error_;
   simdjson::ondemand::parser parser_;
   std::string scratch_;
-  std::string typed_json_;  // a CDR sample decoded to JSON
-  io::CdrSelection typed_selection_;  // the fields of a CDR sample the properties read
+  std::optional<io::CdrDecoder> typed_;  // --type: CDR samples instead of JSON
   io::ChunkReader batch_reader_;
   uint64_t batch_position_ = 0;  // position of the payload being read as a batch, else 0
 };

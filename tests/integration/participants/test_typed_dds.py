@@ -291,3 +291,46 @@ def test_typed_bridge_dds_to_zenoh(rvc, tmp_path, types):
         for p in (echo, bridge):
             if p.poll() is None:
                 p.kill()
+
+
+def test_typed_dense_time_is_the_stamp(rvc, tmp_path, types):
+    """--dense on a typed topic reads each sample's stamp (sec + nanosec) as its time, with no
+    --time-field: verdicts equal `rvc check --dense` on the same values with the time written
+    out as a number. `rvc echo --field` prints only the chosen field."""
+    domain = 210 + os.getpid() % 15
+    rng = random.Random(3)
+    reports, t_ns = [], 5_000_000_000
+    for _ in range(30):
+        t_ns += rng.choice([40, 100, 250, 1000]) * 1_000_000
+        reports.append((t_ns, rng.choice([1, 2, 20, 22])))
+    lines = [json.dumps({"stamp": {"sec": t // 10**9, "nanosec": t % 10**9}, "report": r}) for t, r in reports]
+    trace = tmp_path / "gear.jsonl"
+    trace.write_text("\n".join(lines) + "\n")
+    spec = "{report == REVERSE} -> once[0:0.5]{report == PARK}"
+    topic = "dds:/vehicle/status/gear_dense"
+    common = ["--type", GEAR, "--domain", str(domain), "--idle-timeout", "2"]
+    mon = subprocess.Popen([rvc, "monitor", "--dense", "--spec", spec, "--input", topic, *common],
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    echo = subprocess.Popen([rvc, "echo", topic, "--field", "stamp.sec", *common], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    try:
+        rep = subprocess.run([rvc, "replay", str(trace), "--to", topic, "--type", GEAR, "--domain", str(domain),
+                              "--no-progress", "--wait-subscribers", "2"], capture_output=True, text=True,
+                             timeout=HANG_GUARD)
+        assert rep.returncode == 0, rep.stderr
+        out, err = mon.communicate(timeout=HANG_GUARD)
+        numeric = tmp_path / "numeric.jsonl"
+        numeric.write_text("".join(json.dumps({"t": t / 1e9, "report": r}) + "\n" for t, r in reports))
+        expected = subprocess.run([rvc, "check", "--dense", "--time-field", "t", "--spec",
+                                   "{report == 20} -> once[0:0.5]{report == 22}", str(numeric)],
+                                  capture_output=True, text=True).stdout
+        assert out == expected and '"value":false' in expected, err
+        eout, eerr = echo.communicate(timeout=HANG_GUARD)
+        assert [json.loads(l) for l in eout.splitlines()] == [{"stamp": {"sec": t // 10**9}} for t, _ in reports]
+    finally:
+        for p in (mon, echo):
+            if p.poll() is None:
+                p.kill()
+    bad = subprocess.run([rvc, "echo", topic, "--field", "stamp.seconds", *common], capture_output=True, text=True)
+    assert bad.returncode == 2 and "no field 'seconds' in builtin_interfaces/msg/Time; its fields: sec, nanosec" \
+        in bad.stderr, bad.stderr

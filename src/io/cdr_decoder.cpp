@@ -1,0 +1,293 @@
+#include "io/cdr_decoder.hpp"
+
+#include <algorithm>
+
+#include "io/cdr_cursor.hpp"
+
+namespace rvc::io {
+
+using msg::ArrayKind;
+using msg::FieldType;
+using msg::MessageType;
+using msg::Prim;
+using FOp = spec::FieldTest::Op;
+
+namespace {
+
+const msg::Field* field_named(const MessageType& type, const std::string& name) {
+  for (const auto& f : type.fields)
+    if (f.name == name) return &f;
+  return nullptr;
+}
+
+bool is_single_message(const FieldType& t) { return t.prim == Prim::Message && t.array == ArrayKind::None; }
+
+bool is_number(const FieldType& t) {
+  return t.array == ArrayKind::None && t.prim != Prim::Bool && t.prim != Prim::String && t.prim != Prim::WString &&
+         t.prim != Prim::Message;
+}
+
+// builtin_interfaces/Time and its look-alikes: an integer sec and nanosec.
+bool is_stamp(const FieldType& t) {
+  if (!is_single_message(t)) return false;
+  const msg::Field* sec = field_named(*t.message, "sec");
+  const msg::Field* nanosec = field_named(*t.message, "nanosec");
+  return sec && nanosec && is_number(sec->type) && is_number(nanosec->type) && prim_is_integer(sec->type.prim) &&
+         prim_is_integer(nanosec->type.prim);
+}
+
+std::vector<std::string> split_path(const std::string& path) {
+  std::vector<std::string> parts;
+  size_t start = 0;
+  for (size_t dot; (dot = path.find('.', start)) != std::string::npos; start = dot + 1)
+    parts.push_back(path.substr(start, dot - start));
+  parts.push_back(path.substr(start));
+  return parts;
+}
+
+template <typename T>
+bool number(CdrCursor& in, double& d) {
+  T v;
+  if (!in.read(v)) return false;
+  d = static_cast<double>(v);
+  return true;
+}
+
+}  // namespace
+
+CdrDecoder::CdrDecoder(const engine::AtomTable& atoms, const MessageType& type, const DecoderOptions& options)
+    : atoms_(atoms), options_(options), current_(atoms.size(), 0), next_(atoms.size(), 0) {
+  root_.type = &type;
+  root_.fields.resize(type.fields.size());
+  for (size_t i = 0; i < type.fields.size(); ++i) root_.fields[i].field = &type.fields[i];
+  const auto& tests = atoms_.tests();
+  for (size_t id = 0; id < tests.size(); ++id) {
+    // The dense time field itself may be tested, but is not a field when it
+    // is the time of a type without one: bind_message_type let it through.
+    if (options_.need_time && tests[id].path == split_path(options_.time_field) && !field_named(type, tests[id].path[0]))
+      continue;
+    plan_path(tests[id].path).tests.push_back(static_cast<int>(id));
+  }
+  if (options_.need_time) plan_time(options_.time_field);
+}
+
+CdrDecoder::~CdrDecoder() = default;
+
+std::string CdrDecoder::default_time_field(const MessageType& type, const std::string& requested) {
+  if (requested != "time" || field_named(type, "time")) return requested;
+  if (const msg::Field* h = field_named(type, "header"); h && is_single_message(h->type)) {
+    if (const msg::Field* s = field_named(*h->type.message, "stamp"); s && is_stamp(s->type)) return "header.stamp";
+  }
+  if (const msg::Field* s = field_named(type, "stamp"); s && is_stamp(s->type)) return "stamp";
+  return requested;
+}
+
+// The plan of the field at `path`, creating the nested plans on the way.
+// Paths were checked against the type (runtime::bind_message_type); one that
+// does not resolve is a programming error here, reported as a MsgError.
+CdrDecoder::FieldPlan& CdrDecoder::plan_path(const std::vector<std::string>& path) {
+  Plan* plan = &root_;
+  FieldPlan* found = nullptr;
+  for (size_t i = 0; i < path.size(); ++i) {
+    if (!plan) throw msg::MsgError("field path into a non-message field: " + path[i - 1]);
+    found = nullptr;
+    for (auto& f : plan->fields)
+      if (f.field->name == path[i]) found = &f;
+    if (!found) throw msg::MsgError("no field '" + path[i] + "' in " + plan->type->full_name());
+    plan = nullptr;
+    if (i + 1 < path.size() && is_single_message(found->field->type)) {
+      if (!found->below) {
+        found->below = std::make_unique<Plan>();
+        const MessageType& t = *found->field->type.message;
+        found->below->type = &t;
+        found->below->fields.resize(t.fields.size());
+        for (size_t k = 0; k < t.fields.size(); ++k) found->below->fields[k].field = &t.fields[k];
+      }
+      plan = found->below.get();
+    }
+  }
+  return *found;
+}
+
+void CdrDecoder::plan_time(const std::string& time_field) {
+  const std::vector<std::string> path = split_path(time_field);
+  // Find it first, with an error naming what there is, before planning.
+  const MessageType* holder = root_.type;
+  const msg::Field* f = nullptr;
+  for (size_t i = 0; i < path.size(); ++i) {
+    f = holder ? field_named(*holder, path[i]) : nullptr;
+    if (!f) {
+      throw msg::MsgError("dense time reads field '" + time_field + "' (--time-field), which " +
+                          root_.type->full_name() +
+                          " does not have: give --time-field a number or a builtin_interfaces/Time field, e.g. "
+                          "--time-field stamp or --time-field header.stamp");
+    }
+    holder = is_single_message(f->type) ? f->type.message : nullptr;
+  }
+  if (is_number(f->type)) {
+    plan_path(path).time = TimeRole::Number;
+  } else if (is_stamp(f->type)) {
+    auto with = [&](const char* part) {
+      std::vector<std::string> p = path;
+      p.push_back(part);
+      return p;
+    };
+    plan_path(with("sec")).time = TimeRole::Sec;
+    plan_path(with("nanosec")).time = TimeRole::Nanosec;
+  } else {
+    throw msg::MsgError("dense time field '" + time_field + "' of " + root_.type->full_name() + " is " +
+                        f->type.to_string() + ": it must be a number or a builtin_interfaces/Time (sec, nanosec)");
+  }
+}
+
+bool CdrDecoder::decode(std::string_view sample, std::string& error, std::vector<std::string>* warnings) {
+  std::copy(current_.begin(), current_.end(), next_.begin());  // (memcpy of no atoms: null pointers)
+  malformed_ = false;
+  refused_ = false;
+  error_ = &error;
+  warnings_ = warnings;
+  sec_ = nanosec_ = next_time_ = 0;
+  CdrError bad;
+  CdrCursor in(bad);
+  if (!in.open(sample) || !message(in, root_) || !in.finish()) {
+    malformed_ = !refused_;
+    if (malformed_) error = "bad " + root_.type->full_name() + " sample: " + bad.to_string();
+    return false;
+  }
+  // (sec * 1e9 + nanosec) / 1e9: the correctly rounded time for stamps below
+  // 2^53 ns (104 days); epoch stamps round to about 0.2 us.
+  time_ = next_time_ + (sec_ * 1e9 + nanosec_) / 1e9;
+  return true;
+}
+
+bool CdrDecoder::message(CdrCursor& in, const Plan& plan) {
+  if (plan.fields.empty()) {  // an empty message is one uint8 on the wire
+    uint8_t ignored;
+    return in.read(ignored);
+  }
+  for (const FieldPlan& f : plan.fields) {
+    in.push(&f.field->name);
+    bool ok;
+    if (f.below) {
+      ok = message(in, *f.below);
+      for (int id : f.tests)  // a message with tested fields inside answers only presence
+        if (atoms_.tests()[id].op == FOp::Present) next_[id] = 1;
+    } else if (!f.tests.empty() || f.time != TimeRole::None) {
+      ok = tested_field(in, f);
+    } else {
+      ok = skip(in, f.field->type);
+    }
+    if (!ok) return false;
+    in.pop();
+  }
+  return true;
+}
+
+// A field some test reads (or the time): read its value and evaluate the tests.
+bool CdrDecoder::tested_field(CdrCursor& in, const FieldPlan& f) {
+  const FieldType& t = f.field->type;
+  FieldValue v;
+  if (t.array != ArrayKind::None || t.prim == Prim::Message) {
+    if (!skip(in, t)) return false;
+    v.kind = t.array != ArrayKind::None ? ValueKind::Array : ValueKind::Object;
+    return apply(f, v);
+  }
+  bool ok = true;
+  v.kind = ValueKind::Number;
+  switch (t.prim) {
+    case Prim::Bool:
+      v.kind = ValueKind::Bool;
+      ok = in.boolean(v.b);
+      break;
+    case Prim::Byte: case Prim::Char: case Prim::UInt8: ok = number<uint8_t>(in, v.d); break;
+    case Prim::Int8: ok = number<int8_t>(in, v.d); break;
+    case Prim::Int16: ok = number<int16_t>(in, v.d); break;
+    case Prim::UInt16: ok = number<uint16_t>(in, v.d); break;
+    case Prim::Int32: ok = number<int32_t>(in, v.d); break;
+    case Prim::UInt32: ok = number<uint32_t>(in, v.d); break;
+    case Prim::Int64: ok = number<int64_t>(in, v.d); break;
+    case Prim::UInt64: ok = number<uint64_t>(in, v.d); break;
+    case Prim::Float32: ok = number<float>(in, v.d); break;
+    case Prim::Float64: ok = number<double>(in, v.d); break;
+    case Prim::String:
+      v.kind = ValueKind::String;
+      ok = in.string(v.s, t.string_bound);
+      break;
+    case Prim::WString: return in.fail("wstring fields are not supported");
+    case Prim::Message: break;  // handled above
+  }
+  if (!ok) return false;
+  switch (f.time) {
+    case TimeRole::None: break;
+    case TimeRole::Number: next_time_ = v.d; break;
+    case TimeRole::Sec: sec_ = v.d; break;
+    case TimeRole::Nanosec: nanosec_ = v.d; break;
+  }
+  return apply(f, v);
+}
+
+bool CdrDecoder::apply(const FieldPlan& f, const FieldValue& v) {
+  for (int id : f.tests) {
+    const spec::FieldTest& t = atoms_.tests()[id];
+    const int result = evaluate_test(t, v);
+    if (result >= 0) {
+      next_[id] = static_cast<uint8_t>(result);
+      continue;
+    }
+    const std::string problem = wrong_type_problem(t, v.kind);
+    if (options_.strict) {
+      *error_ = problem;
+      refused_ = true;
+      return false;
+    }
+    if (warnings_) warnings_->push_back(problem + "; it keeps its previous value");
+  }
+  return true;
+}
+
+// Fields no test reads are checked, not looked at: fixed-size numbers are
+// stepped over, everything that can be malformed is read.
+bool CdrDecoder::skip(CdrCursor& in, const FieldType& t) {
+  if (t.array == ArrayKind::None) return skip_element(in, t);
+  uint32_t n = t.array_size;
+  if (t.array == ArrayKind::Unbounded && !in.count(n, cdr_min_size(t))) return false;
+  if (t.array == ArrayKind::Bounded && !in.count(n, cdr_min_size(t), t.array_size)) return false;
+  // Numbers are stepped over in one go when they are all there; else read
+  // one by one, so the error names the element where the sample ends.
+  if (is_number(FieldType{t.prim}) && in.has(msg::prim_size(t.prim), n))
+    return n == 0 || in.skip(msg::prim_size(t.prim), n);
+  for (uint32_t i = 0; i < n; ++i) {
+    in.push_index(i);
+    if (!skip_element(in, t)) return false;
+    in.pop();
+  }
+  return true;
+}
+
+bool CdrDecoder::skip_element(CdrCursor& in, const FieldType& t) {
+  switch (t.prim) {
+    case Prim::Bool: {
+      bool b;
+      return in.boolean(b);
+    }
+    case Prim::String: {
+      std::string_view s;
+      return in.string(s, t.string_bound);
+    }
+    case Prim::WString: return in.fail("wstring fields are not supported");
+    case Prim::Message: return skip_message(in, *t.message);
+    default: return in.skip(msg::prim_size(t.prim), 1);
+  }
+}
+
+bool CdrDecoder::skip_message(CdrCursor& in, const MessageType& type) {
+  if (type.fields.empty()) return in.skip(1, 1);
+  for (const msg::Field& f : type.fields) {
+    in.push(&f.name);
+    if (!skip(in, f.type)) return false;
+    in.pop();
+  }
+  return true;
+}
+
+}  // namespace rvc::io

@@ -1,0 +1,93 @@
+// Decodes one typed (CDR) sample straight into the values of the field tests
+// of a Checker's atom table: the counterpart of JsonDecoder for `--type`,
+// with no JSON in between.
+//
+// The message type is known before the first sample, so the fields the tests
+// read are found once: the decoder walks a plan of the type in wire order,
+// evaluates the tests of each tested field as it passes it, and only checks
+// the rest (bool bytes, string NULs/UTF-8/bounds, counts; fixed-size numbers
+// are stepped over). A bad sample is refused whatever the properties read,
+// with the same words as `rvc echo` and cdr_to_json, since both read through
+// CdrCursor.
+//
+// Dense time: the time field may be a path to a number ("t", "data.time") or
+// to a builtin_interfaces/Time-like message ("stamp", "header.stamp": int32
+// sec + uint32 nanosec, read as sec + nanosec * 1e-9).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "engine/atom_table.hpp"
+#include "io/cdr_codec.hpp"
+#include "io/field_tests.hpp"
+#include "io/json_decoder.hpp"
+#include "msg/msg_types.hpp"
+
+namespace rvc::io {
+
+class CdrCursor;
+
+class CdrDecoder {
+ public:
+  // Throws msg::MsgError for a dense-time field the type lacks or that is
+  // neither a number nor a Time message. (Tests on fields the type lacks
+  // were refused before, by runtime::bind_message_type.)
+  CdrDecoder(const engine::AtomTable& atoms, const msg::MessageType& type, const DecoderOptions& options);
+  ~CdrDecoder();
+
+  // Decodes into a staging copy; false with `error` if the sample must be
+  // refused (`malformed()` then tells a bad sample from a strict-mode
+  // problem). Warnings about tests that kept their previous value are
+  // appended to `warnings`.
+  bool decode(std::string_view sample, std::string& error, std::vector<std::string>* warnings = nullptr);
+  bool malformed() const { return malformed_; }
+  void commit() { current_.swap(next_); }
+
+  const uint8_t* values() const { return current_.data(); }
+  double time() const { return time_; }
+
+  // "time" -> the field dense time reads in a message of this type when the
+  // user kept the default: "time" if the type has it, else "header.stamp",
+  // else "stamp" (every Table-3 message), else "time" (refused later).
+  static std::string default_time_field(const msg::MessageType& type, const std::string& requested);
+
+ private:
+  enum class TimeRole : uint8_t { None, Number, Sec, Nanosec };
+  struct Plan;
+  struct FieldPlan {
+    const msg::Field* field = nullptr;
+    std::vector<int> tests;       // atom ids testing this field
+    std::unique_ptr<Plan> below;  // a nested message with tested (or time) fields inside
+    TimeRole time = TimeRole::None;
+  };
+  struct Plan {
+    const msg::MessageType* type = nullptr;
+    std::vector<FieldPlan> fields;  // one per field of the type, in wire order
+  };
+
+  FieldPlan& plan_path(const std::vector<std::string>& path);
+  void plan_time(const std::string& time_field);
+  bool message(CdrCursor& in, const Plan& plan);
+  bool tested_field(CdrCursor& in, const FieldPlan& f);
+  bool apply(const FieldPlan& f, const FieldValue& value);
+  static bool skip(CdrCursor& in, const msg::FieldType& t);
+  static bool skip_element(CdrCursor& in, const msg::FieldType& t);
+  static bool skip_message(CdrCursor& in, const msg::MessageType& type);
+
+  const engine::AtomTable& atoms_;
+  DecoderOptions options_;
+  Plan root_;
+  std::vector<uint8_t> current_, next_;
+  double time_ = 0, next_time_ = 0;
+  double sec_ = 0, nanosec_ = 0;
+  bool malformed_ = false;
+  bool refused_ = false;  // a strict-mode problem, not a bad sample
+  std::string* error_ = nullptr;               // of the decode in progress
+  std::vector<std::string>* warnings_ = nullptr;
+};
+
+}  // namespace rvc::io

@@ -1,0 +1,66 @@
+#include "io/field_tests.hpp"
+
+namespace rvc::io {
+
+using FOp = spec::FieldTest::Op;
+
+const char* value_kind_name(ValueKind kind) {
+  switch (kind) {
+    case ValueKind::Array: return "an array";
+    case ValueKind::Object: return "an object";
+    case ValueKind::Number: return "a number";
+    case ValueKind::String: return "a string";
+    case ValueKind::Bool: return "a Boolean";
+    case ValueKind::Null: return "null";
+  }
+  return "a value";
+}
+
+namespace {
+
+const char* expected_for(const spec::FieldTest& t) {
+  if (t.op == FOp::Truthy) return "a Boolean or number";
+  switch (t.value.kind) {
+    case spec::Literal::Kind::Bool: return "a Boolean";
+    case spec::Literal::Kind::Number: return "a number";
+    case spec::Literal::Kind::String: return "a string";
+  }
+  return "a value";
+}
+
+}  // namespace
+
+std::string wrong_type_problem(const spec::FieldTest& t, ValueKind kind) {
+  return "field \"" + t.key() + "\" is " + value_kind_name(kind) + ", but {" + t.to_string() + "} needs " +
+         expected_for(t);
+}
+
+int evaluate_test(const spec::FieldTest& t, const FieldValue& v) {
+  const auto lit = t.value.kind;
+  const bool number = v.kind == ValueKind::Number;
+  switch (t.op) {
+    case FOp::Present:
+    case FOp::Bind: return 1;
+    case FOp::Truthy:
+      if (v.kind == ValueKind::Bool) return v.b;
+      if (number) return v.d != 0;
+      if (v.kind == ValueKind::Null) return 0;
+      return -1;
+    case FOp::Eq:
+    case FOp::Ne: {
+      int eq = -1;
+      if (lit == spec::Literal::Kind::Bool && v.kind == ValueKind::Bool) eq = v.b == t.value.b;
+      else if (lit == spec::Literal::Kind::Number && number) eq = v.d == t.value.number;
+      else if (lit == spec::Literal::Kind::String && v.kind == ValueKind::String) eq = v.s == t.value.text;
+      if (eq < 0) return -1;
+      return t.op == FOp::Eq ? eq : !eq;
+    }
+    case FOp::Lt: return number ? v.d < t.value.number : -1;
+    case FOp::Le: return number ? v.d <= t.value.number : -1;
+    case FOp::Gt: return number ? v.d > t.value.number : -1;
+    case FOp::Ge: return number ? v.d >= t.value.number : -1;
+  }
+  return -1;
+}
+
+}  // namespace rvc::io
