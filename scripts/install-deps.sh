@@ -36,9 +36,11 @@ if [ "${#missing[@]}" -gt 0 ]; then
 fi
 
 # Python test oracles and peers: Reelay (the reference monitors), the official
-# Zenoh binding, CycloneDDS's Python binding, rosbags (ROS 2 CDR), pytest.
+# Zenoh binding, CycloneDDS's Python binding, rosbags (ROS 2 CDR and rosbag2 bags),
+# Foxglove's MCAP writer with its chunk compressions (zstd, lz4), pytest.
 PY=${PYTHON:-python3}
-PIP_PACKAGES=(pytest "reelay==25.0.0" "eclipse-zenoh==1.10.2" "cyclonedds==11.0.1" "rosbags==0.11.9" matplotlib)
+PIP_PACKAGES=(pytest "reelay==25.0.0" "eclipse-zenoh==1.10.2" "cyclonedds==11.0.1" "rosbags==0.11.9" matplotlib
+  "mcap==1.6.0" "zstandard==0.25.0" "lz4==4.4.5")
 if ! "$PY" - "${PIP_PACKAGES[@]}" <<'PYEOF' 2>/dev/null
 import sys
 from importlib.metadata import version, PackageNotFoundError

@@ -9,7 +9,12 @@
 
 #include "cli/check_options.hpp"
 #include "cli/commands.hpp"
+#include "msg/type_registry.hpp"
 #include "runtime/check_stream.hpp"
+#ifdef RVC_HAVE_MCAP
+#include "runtime/check_bag.hpp"
+#include "transport/mcap/mcap_bag.hpp"
+#endif
 #include "transport/file_endpoint.hpp"
 
 namespace rvc::cli {
@@ -22,12 +27,21 @@ struct CheckCommand {
   std::string input;
   std::string output = "-";
   bool summary = false;
+  std::string topic;  // --topic: which topic of a bag
+  msg::TypeRegistry registry;  // types from a bag's schemas
 
   int run() {
     auto properties = check.properties();
     const std::string path = strip_file_scheme(input), opath = strip_file_scheme(output);
     if (path != "-" && opath != "-" && runtime::same_regular_file(path, opath)) {
       std::fprintf(stderr, "rvc: --output '%s' is the trace being read: refusing to overwrite it\n", opath.c_str());
+      return kUsage;
+    }
+    const bool bag = input.rfind("mcap:", 0) == 0;
+    if (bag || (path != "-" && is_bag(path))) return run_bag(properties, bag ? input.substr(5) : path, opath);
+    if (!topic.empty()) {
+      std::fprintf(stderr, "rvc: --topic chooses a topic of a bag (MCAP); '%s' is a JSON-lines trace\n",
+                   path.c_str());
       return kUsage;
     }
     int fd = 0;
@@ -48,6 +62,47 @@ struct CheckCommand {
     // Reading stdin: show each verdict as soon as it is known.
     runtime::Outcome outcome = runtime::check_stream(fd, pipeline, outputs, ropts, path == "-");
     if (fd != 0) ::close(fd);
+    report(pipeline);
+    return outcome.exit_code();
+  }
+
+  static bool is_bag(const std::string& path) {
+#ifdef RVC_HAVE_MCAP
+    return transport::McapBag::looks_like_mcap(path);
+#else
+    (void)path;
+    return false;
+#endif
+  }
+
+  // A ROS 2 bag: one topic, its type from the bag's own schema.
+  int run_bag(const std::vector<engine::PropertySpec>& properties, const std::string& path,
+              const std::string& opath) {
+#ifdef RVC_HAVE_MCAP
+    const runtime::BagInput bag = runtime::select_bag_topic(path, topic, registry);
+    runtime::PipelineOptions popts = check.pipeline_options();
+    popts.type = bag.type;
+    popts.position_name = "message";
+    std::vector<std::unique_ptr<transport::Sink>> sinks;
+    sinks.push_back(std::make_unique<transport::FileSink>(opath));
+    runtime::VerdictOutputs outputs(std::move(sinks), !check.dense);
+    runtime::Pipeline pipeline(properties, popts, [&](const engine::Verdict& v) { outputs.put(v); });
+    if (summary)
+      std::fprintf(stderr, "rvc check: %s, topic %s (%s, %llu messages)\n", path.c_str(), bag.topic.c_str(),
+                   bag.type ? bag.type->full_name().c_str() : "JSON", static_cast<unsigned long long>(bag.messages));
+    const runtime::Outcome outcome = runtime::check_bag(bag, pipeline, outputs);
+    report(pipeline);
+    return outcome.exit_code();
+#else
+    (void)properties;
+    (void)opath;
+    std::fprintf(stderr, "rvc: '%s' is an MCAP bag, and this rvc was built without MCAP (RVC_WITH_ZENOH=OFF)\n",
+                 path.c_str());
+    return kUsage;
+#endif
+  }
+
+  void report(const runtime::Pipeline& pipeline) const {
     const auto& s = pipeline.stats();
     if (summary || s.rejected > 0) {
       std::fprintf(stderr, "rvc: %llu messages checked, %llu rejected, %llu warnings; %s\n",
@@ -55,7 +110,6 @@ struct CheckCommand {
                    static_cast<unsigned long long>(s.warnings),
                    pipeline.violated() ? "a property was violated" : "no property was violated");
     }
-    return outcome.exit_code();
   }
 };
 
@@ -63,9 +117,11 @@ struct CheckCommand {
 
 Runner register_check(CLI::App& app) {
   auto cmd = std::make_shared<CheckCommand>();
-  CLI::App* sub = app.add_subcommand("check", "Check properties over a JSON-lines trace (file or - for stdin)");
+  CLI::App* sub = app.add_subcommand("check", "Check properties over a JSON-lines trace (file or - for stdin) or a ROS 2 bag (MCAP)");
   cmd->check.add_to(*sub);
-  sub->add_option("trace", cmd->input, "Trace: PATH, file:PATH or - for stdin")->required();
+  sub->add_option("trace", cmd->input, "Trace: PATH, file:PATH or - for stdin (JSON lines), or a ROS 2 bag (MCAP)")
+      ->required();
+  sub->add_option("--topic", cmd->topic, "The topic of a bag to check (needed when the bag holds several)");
   sub->add_option("--output,-o", cmd->output, "Where verdicts go: PATH, file:PATH or - (stdout)")->capture_default_str();
   sub->add_flag("--summary", cmd->summary, "Print message counts to stderr at the end");
   sub->footer(

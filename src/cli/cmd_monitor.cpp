@@ -12,8 +12,12 @@
 #include "cli/commands.hpp"
 #include "cli/transport_flags.hpp"
 #include "cli/signals.hpp"
+#include "io/json_writer.hpp"
 #include "msg/type_registry.hpp"
 #include "runtime/monitor_loop.hpp"
+#ifdef RVC_HAVE_MCAP
+#include "runtime/check_bag.hpp"
+#endif
 #include "transport/transport_options.hpp"
 
 namespace rvc::cli {
@@ -35,6 +39,47 @@ struct MonitorCommand {
   std::string type;                    // --type: payloads are CDR samples of this ROS 2 type
   std::vector<std::string> msg_paths;  // --msg-path
   msg::TypeRegistry registry;          // owns the type the pipeline decodes
+  std::string topic;                   // --topic: of an mcap: input
+
+  // A ROS 2 bag: played through the runtime at once, its topic's type from
+  // the bag's own schema (as `rvc check bag.mcap`).
+  int run_bag(const std::vector<engine::PropertySpec>& properties, runtime::PipelineOptions popts,
+              runtime::VerdictOutputs& verdicts) {
+#ifdef RVC_HAVE_MCAP
+    if (!type.empty()) {
+      std::fprintf(stderr, "rvc: a bag names the type of each topic itself: drop --type\n");
+      return kUsage;
+    }
+    const runtime::BagInput bag = runtime::select_bag_topic(input.substr(5), topic, registry);
+    popts.type = bag.type;
+    popts.position_name = "message";
+    runtime::Pipeline pipeline(properties, popts, [&](const engine::Verdict& v) { verdicts.put(v); });
+    std::fprintf(stderr, "rvc monitor: %zu propert%s on %s, topic %s (%s, %llu messages) -> %zu output%s\n",
+                 properties.size(), properties.size() == 1 ? "y" : "ies", input.c_str(), bag.topic.c_str(),
+                 bag.type ? bag.type->full_name().c_str() : "JSON", static_cast<unsigned long long>(bag.messages),
+                 verdicts.size(), verdicts.size() == 1 ? "" : "s");
+    const runtime::Outcome outcome = runtime::check_bag(bag, pipeline, verdicts);
+    const auto& s = pipeline.stats();
+    const std::string stats = io::JsonObject()
+                                  .add("input", input)
+                                  .add("topic", bag.topic)
+                                  .add("messages", bag.messages)
+                                  .add("checked", s.accepted)
+                                  .add("rejected", s.rejected)
+                                  .add("warnings", s.warnings)
+                                  .add("verdicts", verdicts.count())
+                                  .add("violations", pipeline.checker().violations())
+                                  .str();
+    std::fprintf(stderr, "%s\n", stats.c_str());
+    return outcome.exit_code();
+#else
+    (void)properties;
+    (void)popts;
+    (void)verdicts;
+    std::fprintf(stderr, "rvc: this rvc was built without MCAP bags (RVC_WITH_ZENOH=OFF)\n");
+    return kUsage;
+#endif
+  }
 
   // An output that the input would read back (the same file, an
   // intersecting key expression, the same topic) feeds the monitor its own
@@ -75,6 +120,11 @@ struct MonitorCommand {
     runtime::VerdictOutputs verdicts(std::move(sinks), !check.dense);
     runtime::PipelineOptions popts = check.pipeline_options();
     popts.position_name = "seq";
+    if (transport::scheme_of(input) == "mcap") return run_bag(properties, popts, verdicts);
+    if (!topic.empty()) {
+      std::fprintf(stderr, "rvc: --topic chooses a topic of a bag (--input mcap:PATH)\n");
+      return kUsage;
+    }
     transport::TransportOptions input_transports = transports;  // outputs stay std_msgs/String
     if (!type.empty()) {
       const std::string scheme = transport::scheme_of(input);
@@ -119,7 +169,7 @@ Runner register_monitor(CLI::App& app) {
   auto cmd = std::make_shared<MonitorCommand>();
   CLI::App* sub = app.add_subcommand("monitor", "Monitor a topic: subscribe, check properties, publish verdicts");
   cmd->check.add_to(*sub);
-  sub->add_option("--input,-i", cmd->input, "Endpoint to monitor: zenoh:KEYEXPR, dds:TOPIC, file:PATH or -")
+  sub->add_option("--input,-i", cmd->input, "Endpoint to monitor: zenoh:KEYEXPR, dds:TOPIC, file:PATH, - or mcap:BAG (a ROS 2 bag)")
       ->required();
   sub->add_option("--output,-o", cmd->outputs, "Where verdicts go (repeatable): zenoh:KEY, dds:TOPIC, file:PATH, - (default)")
       ->allow_extra_args(false);
@@ -143,6 +193,7 @@ Runner register_monitor(CLI::App& app) {
                   "ROS 2 message type of the input's CDR payloads, pkg/msg/Name (`rvc msg list`, `rvc msg show`)");
   sub->add_option("--msg-path", cmd->msg_paths,
                   "Folder of .msg definitions for --type: a ROS 2 share/ tree or a plain folder (repeatable)");
+  sub->add_option("--topic", cmd->topic, "With --input mcap:BAG: the topic to check (if the bag holds several)");
   sub->add_option("--queue", cmd->queue_capacity, "Messages buffered between transport and engine")->capture_default_str();
   add_transport_options(*sub, cmd->transports);
   sub->footer(

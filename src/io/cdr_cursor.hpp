@@ -63,7 +63,7 @@ class CdrCursor {
     return true;
   }
   bool boolean(bool& b) {
-    uint8_t v;
+    uint8_t v = 0;
     if (!read(v)) return false;
     if (v > 1) {
       pos_ -= 1;

@@ -22,10 +22,11 @@ const msg::Field* field_named(const MessageType& type, const std::string& name) 
 
 bool is_single_message(const FieldType& t) { return t.prim == Prim::Message && t.array == ArrayKind::None; }
 
-bool is_number(const FieldType& t) {
-  return t.array == ArrayKind::None && t.prim != Prim::Bool && t.prim != Prim::String && t.prim != Prim::WString &&
-         t.prim != Prim::Message;
+bool prim_is_number(Prim p) {
+  return p != Prim::Bool && p != Prim::String && p != Prim::WString && p != Prim::Message;
 }
+
+bool is_number(const FieldType& t) { return t.array == ArrayKind::None && prim_is_number(t.prim); }
 
 // builtin_interfaces/Time and its look-alikes: an integer sec and nanosec.
 bool is_stamp(const FieldType& t) {
@@ -47,7 +48,7 @@ std::vector<std::string> split_path(const std::string& path) {
 
 template <typename T>
 bool number(CdrCursor& in, double& d) {
-  T v;
+  T v{};
   if (!in.read(v)) return false;
   d = static_cast<double>(v);
   return true;
@@ -254,7 +255,7 @@ bool CdrDecoder::skip(CdrCursor& in, const FieldType& t) {
   if (t.array == ArrayKind::Bounded && !in.count(n, cdr_min_size(t), t.array_size)) return false;
   // Numbers are stepped over in one go when they are all there; else read
   // one by one, so the error names the element where the sample ends.
-  if (is_number(FieldType{t.prim}) && in.has(msg::prim_size(t.prim), n))
+  if (prim_is_number(t.prim) && in.has(msg::prim_size(t.prim), n))
     return n == 0 || in.skip(msg::prim_size(t.prim), n);
   for (uint32_t i = 0; i < n; ++i) {
     in.push_index(i);

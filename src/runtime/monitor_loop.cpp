@@ -75,6 +75,7 @@ void MonitorLoop::publish_stats() {
 }
 
 void MonitorLoop::process(transport::Source& source) {
+  counters_.expect(options_.publishers);
   transport::FrameQueue queue(options_.queue_capacity);
   Shutdown shutdown(queue, source);
   source.start([&queue](const transport::Frame& f) { queue.push(f); });

@@ -25,14 +25,16 @@ Parsed parse(const std::string& uri) {
   auto colon = uri.find(':');
   if (colon == std::string::npos) return {"file", uri};  // a plain path
   std::string scheme = uri.substr(0, colon), rest = uri.substr(colon + 1);
-  if (scheme == "file" || scheme == "zenoh" || scheme == "dds") {
+  if (scheme == "file" || scheme == "zenoh" || scheme == "dds" || scheme == "mcap") {
     if (rest.empty()) throw std::invalid_argument("endpoint '" + uri + "' names no " +
-                                                  (scheme == "file" ? "path" : scheme == "dds" ? "topic" : "key expression"));
+                                                  (scheme == "file" || scheme == "mcap" ? "path"
+                                                   : scheme == "dds"                    ? "topic"
+                                                                                        : "key expression"));
     return {scheme, rest};
   }
   if (scheme.size() == 1) return {"file", uri};  // not a scheme: a Windows-like path "C:..."
   throw std::invalid_argument("unknown endpoint scheme '" + scheme + ":' in '" + uri +
-                              "' (use file:PATH, -, zenoh:KEYEXPR or dds:TOPIC)");
+                              "' (use file:PATH, -, zenoh:KEYEXPR, dds:TOPIC or, as an input, mcap:BAG)");
 }
 
 [[noreturn, maybe_unused]] void not_built(const std::string& scheme) {
@@ -46,6 +48,9 @@ std::string scheme_of(const std::string& uri) { return parse(uri).scheme; }
 
 bool endpoints_overlap(const std::string& a, const std::string& b) {
   Parsed pa = parse(a), pb = parse(b);
+  // A bag is a file: writing verdicts over it is reading back one's output.
+  if (pa.scheme == "mcap") pa.scheme = "file";
+  if (pb.scheme == "mcap") pb.scheme = "file";
   if (pa.scheme != pb.scheme) return false;
   if (pa.scheme == "file") {
     if (pa.rest == "-" || pb.rest == "-") return false;  // stdin and stdout are different streams
@@ -69,6 +74,8 @@ bool endpoints_overlap(const std::string& a, const std::string& b) {
 
 std::unique_ptr<Source> open_source(const std::string& uri, const TransportOptions& options) {
   Parsed p = parse(uri);
+  if (p.scheme == "mcap")  // read whole by the runtime (runtime/check_bag.hpp), not as a stream
+    throw std::invalid_argument("'" + uri + "': bags are read by rvc check and rvc monitor --input, not here");
   if (p.scheme == "file") return std::make_unique<FileSource>(p.rest);
   if (p.scheme == "zenoh") {
 #ifdef RVC_HAVE_ZENOH
@@ -86,6 +93,7 @@ std::unique_ptr<Source> open_source(const std::string& uri, const TransportOptio
 
 std::unique_ptr<Sink> open_sink(const std::string& uri, const TransportOptions& options) {
   Parsed p = parse(uri);
+  if (p.scheme == "mcap") throw std::invalid_argument("'" + uri + "': rvc reads bags (mcap:), it does not write them");
   if (p.scheme == "file") return std::make_unique<FileSink>(p.rest);
   if (p.scheme == "zenoh") {
 #ifdef RVC_HAVE_ZENOH

@@ -28,6 +28,10 @@ class SeqCounters {
   // End of stream: the publisher tells its last seq; anything after ours is lost.
   void on_eos(uint64_t publisher_last_seq, uint64_t publisher = 0);
 
+  // How many publishers the run expects (monitor --publishers N): until that
+  // many have been seen, a newcomer after another one ended is one of them
+  // discovered late, not a publisher that restarted.
+  void expect(size_t publishers) { expected_ = publishers; }
   size_t publishers() const { return by_publisher_.size(); }
   // Every publisher seen so far has sent its end-of-stream marker.
   bool all_ended() const { return ended_ == by_publisher_.size(); }
@@ -42,6 +46,7 @@ class SeqCounters {
   std::unordered_map<uint64_t, Publisher> by_publisher_;
   size_t ended_ = 0;
   bool any_ended_ = false;  // some publisher ended: a newcomer after it is a restart
+  size_t expected_ = 1;
 };
 
 // Header-only: the transports' own test probes use it without the rest of rvc.
@@ -49,7 +54,9 @@ inline SeqCounters::Publisher& SeqCounters::publisher(uint64_t id, uint64_t seq)
   auto [it, fresh] = by_publisher_.try_emplace(id);
   Publisher& p = it->second;
   if (fresh) {
-    if (any_ended_) ++restarts;  // a publisher that ended, started again (DDS and Zenoh give it a new id)
+    // A publisher that ended, started again (DDS and Zenoh give it a new id);
+    // unless fewer publishers than expected were seen before this one.
+    if (any_ended_ && by_publisher_.size() - 1 >= expected_) ++restarts;
     return p;
   }
   // The same publisher numbering from the start again: it restarted.

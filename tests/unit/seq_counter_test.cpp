@@ -60,6 +60,22 @@ TEST(SeqCounters, NewPublisherAfterAnEndOfStreamIsARestart) {
   EXPECT_EQ(c.duplicates + c.gaps, 0u);
 }
 
+// monitor --publishers 2: the second publisher, discovered only after the
+// first ended (CI under ASan), is not a restart; a third one is.
+TEST(SeqCounters, ExpectedPublishersDiscoveredLateAreNotRestarts) {
+  SeqCounters c;
+  c.expect(2);
+  for (uint64_t s = 1; s <= 3; ++s) c.on_seq(s, 1);
+  c.on_eos(3, 1);
+  for (uint64_t s = 1; s <= 2; ++s) c.on_seq(s, 2);
+  c.on_eos(2, 2);
+  EXPECT_EQ(c.restarts, 0u);
+  EXPECT_TRUE(c.all_ended());
+  c.on_seq(1, 3);
+  EXPECT_EQ(c.restarts, 1u);
+  EXPECT_EQ(c.gaps + c.duplicates, 0u);
+}
+
 TEST(SeqCounters, UnnumberedMessagesAreCountedOnly) {
   SeqCounters c;
   c.on_seq(0);

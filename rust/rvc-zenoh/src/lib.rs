@@ -1,4 +1,6 @@
-//! rvc-zenoh: the narrow C ABI through which rvc's C++ transport talks to Zenoh.
+//! rvc-zenoh: the narrow C ABI through which rvc's C++ transport talks to Zenoh
+//! (and, in `mcap_reader`, reads MCAP bags with the `mcap` crate: one Rust
+//! static library per binary, since two would each carry Rust's runtime).
 //!
 //! Why a Rust shim instead of zenoh-c: Zenoh has no Debian package and zenoh-c
 //! is a large generated API. rvc needs five things (open a session, subscribe
@@ -27,6 +29,8 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Condvar, Mutex, RwLock};
 use std::time::{Duration, Instant};
+
+mod mcap_reader;
 
 use zenoh::bytes::ZBytes;
 use zenoh::key_expr::KeyExpr;

@@ -1,0 +1,35 @@
+// Checking a ROS 2 bag (MCAP): the messages of one topic, in the order the bag
+// stores them, through the same Pipeline and VerdictOutputs as a JSON-lines
+// file. The topic's type comes from the bag's own schema (a ROS 2 bag
+// carries the .msg text of every type it holds), so no --msg-path is needed.
+#pragma once
+
+#include <string>
+
+#include "msg/type_registry.hpp"
+#include "runtime/exit_status.hpp"
+#include "runtime/pipeline.hpp"
+#include "runtime/verdict_outputs.hpp"
+
+namespace rvc::runtime {
+
+struct BagInput {
+  std::string path;
+  std::string topic;                     // the topic checked
+  const msg::MessageType* type = nullptr;  // CDR samples of this type; null: JSON messages
+  uint64_t messages = 0;                 // of that topic
+};
+
+// Picks the topic to check: `topic` if given (it must be in the bag), else
+// the bag's only topic. Registers its schema in `registry` and resolves the
+// type. Throws std::invalid_argument naming the bag's topics (with their
+// types and counts) when there is no single choice, and for encodings rvc
+// cannot read; transport::McapError for a file that is no bag.
+BagInput select_bag_topic(const std::string& path, const std::string& topic, msg::TypeRegistry& registry);
+
+// Feeds every message of the chosen topic to the pipeline (positions are the
+// messages' 1-based indexes in the bag, over all topics). Like check_stream,
+// never throws for a failure while running: the outcome says so.
+Outcome check_bag(const BagInput& input, Pipeline& pipeline, VerdictOutputs& outputs);
+
+}  // namespace rvc::runtime

@@ -1,0 +1,177 @@
+"""ROS 2 bags (MCAP): `rvc check bag.mcap --topic T` and `rvc monitor --input mcap:bag.mcap`.
+
+Independent writers: rosbags' rosbag2 writer with its MCAP storage (the layout `ros2 bag record -s
+mcap` makes: a folder with metadata.yaml and the .mcap, CDR samples serialized by rosbags, schemas
+as ros2msg text) and the `mcap` package from PyPI (Foxglove's reference writer) with each chunk
+compression (zstd, lz4, none). The type of each topic comes from the bag's own schema: no
+--msg-path. Oracle for verdicts: `rvc check` on the same values written as JSON lines.
+"""
+import json
+import os
+import random
+import struct
+import subprocess
+
+import pytest
+
+from conftest import transports_built
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+DEFS = os.path.join(ROOT, "src", "msg", "definitions")
+GEAR = "autoware_auto_vehicle_msgs/msg/GearReport"
+STEER = "autoware_auto_vehicle_msgs/msg/SteeringReport"
+GEAR_TOPIC, STEER_TOPIC = "/vehicle/status/gear_status", "/vehicle/status/steering_status"
+
+
+@pytest.fixture
+def typestore(rvc):
+    if "zenoh" not in transports_built(rvc):  # the MCAP reader lives in the Rust library
+        pytest.fail("this rvc was built without its Rust library (RVC_WITH_ZENOH=OFF): no MCAP")
+    from rosbags.typesys import Stores, get_typestore
+    from rosbags.typesys.msg import get_types_from_msg
+    ts = get_typestore(Stores.ROS2_HUMBLE)
+    for name in (GEAR, STEER):
+        with open(os.path.join(DEFS, name.split("/")[0], "msg", name.split("/")[-1] + ".msg")) as f:
+            ts.register(get_types_from_msg(f.read(), name))
+    return ts
+
+
+def run(args, **kw):
+    return subprocess.run(args, capture_output=True, text=True, timeout=120, **kw)
+
+
+def gear_values(n, seed):
+    rng = random.Random(seed)
+    t, out = 1_700_000_000 * 10**9, []
+    for _ in range(n):
+        t += rng.choice([40, 100, 250]) * 10**6
+        out.append((t, rng.choice([1, 2, 20, 22])))
+    return out
+
+
+def write_rosbag2(tmp_path, ts, gears, steers):
+    """A rosbag2 folder in MCAP storage, as `ros2 bag record -s mcap` writes it."""
+    from rosbags.rosbag2 import Writer
+    from rosbags.rosbag2.enums import StoragePlugin
+    Time = ts.types["builtin_interfaces/msg/Time"]
+    folder = tmp_path / "drive"
+    with Writer(folder, version=9, storage_plugin=StoragePlugin.MCAP) as w:
+        cg = w.add_connection(GEAR_TOPIC, GEAR, typestore=ts)
+        cs = w.add_connection(STEER_TOPIC, STEER, typestore=ts)
+        events = [(t, cg, ts.types[GEAR](stamp=Time(sec=t // 10**9, nanosec=t % 10**9), report=r), GEAR)
+                  for t, r in gears]
+        events += [(t, cs, ts.types[STEER](stamp=Time(sec=t // 10**9, nanosec=t % 10**9),
+                                           steering_tire_angle=a), STEER) for t, a in steers]
+        for t, conn, msg, name in sorted(events, key=lambda e: e[0]):
+            w.write(conn, t, ts.serialize_cdr(msg, name))
+    bags = list(folder.glob("*.mcap"))
+    assert len(bags) == 1
+    return str(bags[0])
+
+
+def json_trace(tmp_path, name, rows):
+    p = tmp_path / name
+    p.write_text("".join(json.dumps(r) + "\n" for r in rows))
+    return str(p)
+
+
+def test_rosbag2_bag_checks_like_its_json(rvc, tmp_path, typestore):
+    gears = gear_values(60, 1)
+    steers = [(t + 7, random.Random(t).uniform(-0.6, 0.6)) for t, _ in gear_values(80, 2)]
+    bag = write_rosbag2(tmp_path, typestore, gears, steers)
+    spec = "{report == REVERSE} -> pre {report == PARK}"
+    got = run([rvc, "check", "--all", "--summary", "--spec", spec, bag, "--topic", GEAR_TOPIC])
+    expected = run([rvc, "check", "--all", "--spec", "{report == 20} -> pre {report == 22}",
+                    json_trace(tmp_path, "gear.jsonl", [{"report": r} for _, r in gears])])
+    assert got.stdout == expected.stdout and '"value":false' in expected.stdout, got.stderr
+    assert got.returncode == expected.returncode == 1
+    assert f"topic {GEAR_TOPIC} ({GEAR}, 60 messages)" in got.stderr
+    # The same bag through `rvc monitor --input mcap:` (one runtime): the same verdicts.
+    mon = run([rvc, "monitor", "--all", "--spec", spec, "--input", f"mcap:{bag}", "--topic", GEAR_TOPIC])
+    assert mon.stdout == expected.stdout, mon.stderr
+    stats = json.loads(mon.stderr.strip().splitlines()[-1])
+    assert (stats["topic"], stats["checked"], stats["rejected"]) == (GEAR_TOPIC, 60, 0)
+    # Dense time reads each sample's stamp: equal to the JSON trace with the stamp as a number.
+    steer_spec = "historically[0:0.3]{steering_tire_angle < 0.5}"
+    dense = run([rvc, "check", "--dense", "--spec", steer_spec, bag, "--topic", STEER_TOPIC])
+    f32 = lambda a: struct.unpack("<f", struct.pack("<f", a))[0]  # the wire type is float32
+    rows = [{"t": t / 1e9, "steering_tire_angle": f32(a)} for t, a in steers]
+    want = run([rvc, "check", "--dense", "--time-field", "t", "--spec", steer_spec,
+                json_trace(tmp_path, "steer.jsonl", rows)])
+    assert dense.stdout == want.stdout and '"value":false' in want.stdout, dense.stderr
+
+
+def test_choosing_the_topic(rvc, tmp_path, typestore):
+    bag = write_rosbag2(tmp_path, typestore, gear_values(5, 3), [(10**9 * i, 0.1) for i in range(1, 4)])
+    r = run([rvc, "check", "--spec", "{report == 2}", bag])
+    assert r.returncode == 2
+    assert "holds 2 topics: choose one with --topic" in r.stderr
+    assert f"{GEAR_TOPIC} ({GEAR}, 5 messages)" in r.stderr and f"{STEER_TOPIC} ({STEER}, 3 messages)" in r.stderr
+    r = run([rvc, "check", "--spec", "{report == 2}", bag, "--topic", "/vehicle/gear"])
+    assert r.returncode == 2 and "has no topic '/vehicle/gear'" in r.stderr
+    # A field the bag's type lacks is a spec error pointing at it, as with --type.
+    r = run([rvc, "check", "--spec", "{gear == 2}", bag, "--topic", GEAR_TOPIC])
+    assert r.returncode == 2 and "no field 'gear'" in r.stderr, r.stderr
+    r = run([rvc, "check", "--spec", "{p}", "--topic", GEAR_TOPIC,
+             json_trace(tmp_path, "x.jsonl", [{"p": True}])])
+    assert r.returncode == 2 and "--topic chooses a topic of a bag" in r.stderr
+
+
+@pytest.mark.parametrize("compression", ["zstd", "lz4", "none"])
+def test_mcap_writer_chunk_compressions(rvc, tmp_path, typestore, compression):
+    """Foxglove's writer, each chunk compression; small chunks so the bag has many."""
+    from mcap.writer import CompressionType, Writer
+    gears = gear_values(300, 4)
+    path = tmp_path / f"gear-{compression}.mcap"
+    text, _ = typestore.generate_msgdef(GEAR, ros_version=2)
+    Time = typestore.types["builtin_interfaces/msg/Time"]
+    with open(path, "wb") as f:
+        w = Writer(f, chunk_size=512, compression=getattr(CompressionType, compression.upper()))
+        w.start(profile="ros2", library="rvc tests")
+        schema = w.register_schema(name=GEAR, encoding="ros2msg", data=text.encode())
+        ch = w.register_channel(topic=GEAR_TOPIC, message_encoding="cdr", schema_id=schema)
+        for i, (t, r) in enumerate(gears):
+            data = typestore.serialize_cdr(typestore.types[GEAR](stamp=Time(sec=t // 10**9, nanosec=t % 10**9),
+                                                                 report=r), GEAR)
+            w.add_message(channel_id=ch, log_time=t, publish_time=t, sequence=i, data=data)
+        w.finish()
+    spec = "{report == REVERSE} -> once[0:0.5]{report == PARK}"
+    got = run([rvc, "check", "--dense", "--spec", spec, str(path)])  # one topic: no --topic needed
+    want = run([rvc, "check", "--dense", "--time-field", "t", "--spec", "{report == 20} -> once[0:0.5]{report == 22}",
+                json_trace(tmp_path, "g.jsonl", [{"t": t / 1e9, "report": r} for t, r in gears])])
+    assert got.stdout == want.stdout and '"value":false' in want.stdout, got.stderr
+
+
+def test_json_messages_in_a_bag(rvc, tmp_path, typestore):
+    from mcap.writer import Writer
+    rows = [{"p": i % 3 != 0, "q": i % 2 == 0} for i in range(20)]
+    path = tmp_path / "json.mcap"
+    with open(path, "wb") as f:
+        w = Writer(f)
+        w.start(profile="", library="rvc tests")
+        ch = w.register_channel(topic="/status", message_encoding="json", schema_id=0)
+        for i, row in enumerate(rows):
+            w.add_message(channel_id=ch, log_time=i, publish_time=i, sequence=i, data=json.dumps(row).encode())
+        w.finish()
+    got = run([rvc, "check", "--all", "--spec", "{p} -> {q}", str(path)])
+    want = run([rvc, "check", "--all", "--spec", "{p} -> {q}", json_trace(tmp_path, "j.jsonl", rows)])
+    assert got.stdout == want.stdout and got.returncode == want.returncode == 1, got.stderr
+
+
+def test_broken_bags_are_named(rvc, tmp_path, typestore):
+    bag = write_rosbag2(tmp_path, typestore, gear_values(400, 5), [])
+    data = open(bag, "rb").read()
+    cut = tmp_path / "cut.mcap"
+    cut.write_bytes(data[: len(data) // 2])  # a recording that stopped mid-file
+    r = run([rvc, "check", "--all", "--spec", "{report >= 0}", str(cut)])
+    # What was recorded before the break is checked (nothing valid is lost), the break is named: exit 3.
+    assert r.returncode == 3 and "cut.mcap" in r.stderr and "the messages before it were checked" in r.stderr
+    checked = len(r.stdout.splitlines())
+    assert 100 < checked < 400, r.stderr
+    whole = run([rvc, "check", "--all", "--spec", "{report >= 0}", bag])
+    assert r.stdout == "".join(whole.stdout.splitlines(keepends=True)[:checked])
+    assert "Traceback" not in r.stderr and "panic" not in r.stderr
+    junk = tmp_path / "junk.mcap"
+    junk.write_bytes(data[:8] + bytes(random.Random(1).randrange(256) for _ in range(300)))
+    r = run([rvc, "check", "--spec", "{report == 2}", str(junk)])
+    assert r.returncode == 2 and "junk.mcap" in r.stderr, r.stderr
