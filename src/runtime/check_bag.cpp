@@ -4,6 +4,7 @@
 #include <exception>
 #include <stdexcept>
 
+#include "runtime/check_stream.hpp"
 #include "transport/mcap/mcap_bag.hpp"
 
 namespace rvc::runtime {
@@ -53,8 +54,7 @@ BagInput select_bag_topic(const std::string& path, const std::string& topic, msg
 }
 
 Outcome check_bag(const BagInput& input, Pipeline& pipeline, VerdictOutputs& outputs) {
-  Outcome outcome;
-  try {
+  return run_check(pipeline, outputs, [&](Outcome& outcome) {
     transport::McapBag bag(input.path);
     transport::McapMessage m;
     for (;;) {
@@ -69,15 +69,7 @@ Outcome check_bag(const BagInput& input, Pipeline& pipeline, VerdictOutputs& out
       }
       if (m.topic == input.topic) pipeline.feed(m.data, m.index);
     }
-    outputs.finish();
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "rvc: error: %s\n", e.what());
-    outcome.runtime_failure = true;
-  }
-  pipeline.finish_report();
-  outcome.violated = pipeline.violated();
-  outcome.rejected = outcome.rejected || pipeline.stats().rejected > 0;
-  return outcome;
+  });
 }
 
 }  // namespace rvc::runtime

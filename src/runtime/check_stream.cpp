@@ -7,15 +7,10 @@
 
 namespace rvc::runtime {
 
-Outcome check_stream(int fd, Pipeline& pipeline, VerdictOutputs& outputs, io::ReaderOptions reader, bool live) {
+Outcome run_check(Pipeline& pipeline, VerdictOutputs& outputs, const std::function<void(Outcome&)>& read) {
   Outcome outcome;
-  if (live) reader.after_chunk = [&outputs] { outputs.idle(); };
   try {
-    std::string error;
-    if (!io::read_jsonl(fd, pipeline, reader, error)) {
-      std::fprintf(stderr, "rvc: error: %s\n", error.c_str());
-      outcome.runtime_failure = true;
-    }
+    read(outcome);
     outputs.finish();
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rvc: error: %s\n", e.what());
@@ -23,8 +18,19 @@ Outcome check_stream(int fd, Pipeline& pipeline, VerdictOutputs& outputs, io::Re
   }
   pipeline.finish_report();
   outcome.violated = pipeline.violated();
-  outcome.rejected = pipeline.stats().rejected > 0;
+  outcome.rejected = outcome.rejected || pipeline.stats().rejected > 0;
   return outcome;
+}
+
+Outcome check_stream(int fd, Pipeline& pipeline, VerdictOutputs& outputs, io::ReaderOptions reader, bool live) {
+  if (live) reader.after_chunk = [&outputs] { outputs.idle(); };
+  return run_check(pipeline, outputs, [&](Outcome& outcome) {
+    std::string error;
+    if (!io::read_jsonl(fd, pipeline, reader, error)) {
+      std::fprintf(stderr, "rvc: error: %s\n", error.c_str());
+      outcome.runtime_failure = true;
+    }
+  });
 }
 
 bool same_regular_file(const std::string& a, const std::string& b) {

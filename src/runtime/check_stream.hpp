@@ -2,6 +2,8 @@
 // through the same Pipeline and VerdictOutputs as `rvc monitor`.
 #pragma once
 
+#include <functional>
+
 #include "io/jsonl_reader.hpp"
 #include "runtime/exit_status.hpp"
 #include "runtime/pipeline.hpp"
@@ -14,6 +16,11 @@ namespace rvc::runtime {
 // reason is printed. `live`: flush verdicts after every chunk read (stdin fed
 // by another program, where verdicts should show as soon as they are known).
 Outcome check_stream(int fd, Pipeline& pipeline, VerdictOutputs& outputs, io::ReaderOptions reader, bool live);
+
+// The frame of every check run: `read` feeds the pipeline (and may note
+// what it met in the outcome), then the outputs get their end-of-stream
+// marker. A failure while running is printed and noted, never thrown.
+Outcome run_check(Pipeline& pipeline, VerdictOutputs& outputs, const std::function<void(Outcome&)>& read);
 
 // True if both paths name the same existing regular file (also through links):
 // used to refuse writing verdicts over the input being read.
