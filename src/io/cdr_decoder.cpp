@@ -58,9 +58,7 @@ bool number(CdrCursor& in, double& d) {
 
 CdrDecoder::CdrDecoder(const engine::AtomTable& atoms, const MessageType& type, const DecoderOptions& options)
     : atoms_(atoms), options_(options), current_(atoms.size(), 0), next_(atoms.size(), 0) {
-  root_.type = &type;
-  root_.fields.resize(type.fields.size());
-  for (size_t i = 0; i < type.fields.size(); ++i) root_.fields[i].field = &type.fields[i];
+  root_ = std::move(*plan_of(type));
   const auto& tests = atoms_.tests();
   for (size_t id = 0; id < tests.size(); ++id) {
     // The dense time field itself may be tested, but is not a field when it
@@ -68,11 +66,24 @@ CdrDecoder::CdrDecoder(const engine::AtomTable& atoms, const MessageType& type, 
     if (options_.need_time && tests[id].path == split_path(options_.time_field) && !field_named(type, tests[id].path[0]))
       continue;
     plan_path(tests[id].path).tests.push_back(static_cast<int>(id));
+    if (tests[id].op == FOp::Present) presence_tests_.push_back(static_cast<int>(id));
   }
   if (options_.need_time) plan_time(options_.time_field);
 }
 
 CdrDecoder::~CdrDecoder() = default;
+
+// A plan of a message type with nothing tested yet: every field skipped.
+std::unique_ptr<CdrDecoder::Plan> CdrDecoder::plan_of(const MessageType& type) {
+  auto plan = std::make_unique<Plan>();
+  plan->type = &type;
+  plan->fields.resize(type.fields.size());
+  for (size_t i = 0; i < type.fields.size(); ++i) {
+    plan->fields[i].name = &type.fields[i].name;
+    plan->fields[i].type = type.fields[i].type;
+  }
+  return plan;
+}
 
 std::string CdrDecoder::default_time_field(const MessageType& type, const std::string& requested) {
   if (requested != "time" || field_named(type, "time")) return requested;
@@ -87,25 +98,34 @@ std::string CdrDecoder::default_time_field(const MessageType& type, const std::s
 // Paths were checked against the type (runtime::bind_message_type); one that
 // does not resolve is a programming error here, reported as a MsgError.
 CdrDecoder::FieldPlan& CdrDecoder::plan_path(const std::vector<std::string>& path) {
-  Plan* plan = &root_;
   FieldPlan* found = nullptr;
   for (size_t i = 0; i < path.size(); ++i) {
-    if (!plan) throw msg::MsgError("field path into a non-message field: " + path[i - 1]);
-    found = nullptr;
-    for (auto& f : plan->fields)
-      if (f.field->name == path[i]) found = &f;
-    if (!found) throw msg::MsgError("no field '" + path[i] + "' in " + plan->type->full_name());
-    plan = nullptr;
-    if (i + 1 < path.size() && is_single_message(found->field->type)) {
-      if (!found->below) {
-        found->below = std::make_unique<Plan>();
-        const MessageType& t = *found->field->type.message;
-        found->below->type = &t;
-        found->below->fields.resize(t.fields.size());
-        for (size_t k = 0; k < t.fields.size(); ++k) found->below->fields[k].field = &t.fields[k];
+    if (spec::is_index_part(path[i])) {  // an element of the array reached so far
+      if (!found || found->type.array == ArrayKind::None)
+        throw msg::MsgError("an index into a field that is no array: " + path[i]);
+      const uint32_t index = spec::index_of_part(path[i]);
+      if (found->elements.size() <= index) found->elements.resize(index + 1);
+      if (!found->elements[index]) {
+        auto element = std::make_unique<FieldPlan>();
+        element->type = found->type;
+        element->type.array = ArrayKind::None;
+        element->type.array_size = 0;
+        found->elements[index] = std::move(element);
       }
+      found = found->elements[index].get();
+      continue;
+    }
+    Plan* plan = &root_;
+    if (found) {
+      if (!is_single_message(found->type)) throw msg::MsgError("field path into a non-message field: " + path[i]);
+      if (!found->below) found->below = plan_of(*found->type.message);
       plan = found->below.get();
     }
+    FieldPlan* next = nullptr;
+    for (auto& f : plan->fields)
+      if (*f.name == path[i]) next = &f;
+    if (!next) throw msg::MsgError("no field '" + path[i] + "' in " + plan->type->full_name());
+    found = next;
   }
   return *found;
 }
@@ -143,6 +163,9 @@ void CdrDecoder::plan_time(const std::string& time_field) {
 
 bool CdrDecoder::decode(std::string_view sample, std::string& error, std::vector<std::string>* warnings) {
   std::copy(current_.begin(), current_.end(), next_.begin());  // (memcpy of no atoms: null pointers)
+  // Fields are always there, array elements not ({pts[3]: *}): presence is
+  // false until the decoder passes the value.
+  for (int id : presence_tests_) next_[id] = 0;
   malformed_ = false;
   refused_ = false;
   error_ = &error;
@@ -167,18 +190,37 @@ bool CdrDecoder::message(CdrCursor& in, const Plan& plan) {
     return in.read(ignored);
   }
   for (const FieldPlan& f : plan.fields) {
-    in.push(&f.field->name);
-    bool ok;
-    if (f.below) {
-      ok = message(in, *f.below);
-      for (int id : f.tests)  // a message with tested fields inside answers only presence
-        if (atoms_.tests()[id].op == FOp::Present) next_[id] = 1;
-    } else if (!f.tests.empty() || f.time != TimeRole::None) {
-      ok = tested_field(in, f);
-    } else {
-      ok = skip(in, f.field->type);
-    }
-    if (!ok) return false;
+    in.push(f.name);
+    if (!planned_value(in, f)) return false;
+    in.pop();
+  }
+  return true;
+}
+
+bool CdrDecoder::planned_value(CdrCursor& in, const FieldPlan& f) {
+  if (f.below || !f.elements.empty()) {
+    if (!(f.below ? message(in, *f.below) : indexed_array(in, f))) return false;
+    // A message or array with tested parts inside answers only presence (as in JSON).
+    for (int id : f.tests)
+      if (atoms_.tests()[id].op == FOp::Present) next_[id] = 1;
+    return true;
+  }
+  if (!f.tests.empty() || f.time != TimeRole::None) return tested_field(in, f);
+  return skip(in, f.type);
+}
+
+// An array some tests index ({ranges[0] < 0.5}): tested elements are read as
+// values, the others checked; an element the sample lacks keeps its tests'
+// values, like a missing JSON field.
+bool CdrDecoder::indexed_array(CdrCursor& in, const FieldPlan& f) {
+  const FieldType& t = f.type;
+  uint32_t n = t.array_size;
+  if (t.array == ArrayKind::Unbounded && !in.count(n, cdr_min_size(t))) return false;
+  if (t.array == ArrayKind::Bounded && !in.count(n, cdr_min_size(t), t.array_size)) return false;
+  for (uint32_t i = 0; i < n; ++i) {
+    in.push_index(i);
+    const FieldPlan* element = i < f.elements.size() ? f.elements[i].get() : nullptr;
+    if (!(element ? planned_value(in, *element) : skip_element(in, t))) return false;
     in.pop();
   }
   return true;
@@ -186,7 +228,7 @@ bool CdrDecoder::message(CdrCursor& in, const Plan& plan) {
 
 // A field some test reads (or the time): read its value and evaluate the tests.
 bool CdrDecoder::tested_field(CdrCursor& in, const FieldPlan& f) {
-  const FieldType& t = f.field->type;
+  const FieldType& t = f.type;
   FieldValue v;
   if (t.array != ArrayKind::None || t.prim == Prim::Message) {
     if (!skip(in, t)) return false;

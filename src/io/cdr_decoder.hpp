@@ -59,9 +59,11 @@ class CdrDecoder {
   enum class TimeRole : uint8_t { None, Number, Sec, Nanosec };
   struct Plan;
   struct FieldPlan {
-    const msg::Field* field = nullptr;
-    std::vector<int> tests;       // atom ids testing this field
-    std::unique_ptr<Plan> below;  // a nested message with tested (or time) fields inside
+    const std::string* name = nullptr;  // the field's name (null: an array element)
+    msg::FieldType type;                // an element's: the array's type without the array
+    std::vector<int> tests;             // atom ids testing this field
+    std::unique_ptr<Plan> below;        // a nested message with tested (or time) fields inside
+    std::vector<std::unique_ptr<FieldPlan>> elements;  // tested elements by index ({ranges[0]}), else null
     TimeRole time = TimeRole::None;
   };
   struct Plan {
@@ -73,6 +75,9 @@ class CdrDecoder {
   void plan_time(const std::string& time_field);
   bool message(CdrCursor& in, const Plan& plan);
   bool tested_field(CdrCursor& in, const FieldPlan& f);
+  bool indexed_array(CdrCursor& in, const FieldPlan& f);
+  bool planned_value(CdrCursor& in, const FieldPlan& f);
+  static std::unique_ptr<Plan> plan_of(const msg::MessageType& type);
   bool apply(const FieldPlan& f, const FieldValue& value);
   static bool skip(CdrCursor& in, const msg::FieldType& t);
   static bool skip_element(CdrCursor& in, const msg::FieldType& t);
@@ -81,6 +86,7 @@ class CdrDecoder {
   const engine::AtomTable& atoms_;
   DecoderOptions options_;
   Plan root_;
+  std::vector<int> presence_tests_;
   std::vector<uint8_t> current_, next_;
   double time_ = 0, next_time_ = 0;
   double sec_ = 0, nanosec_ = 0;

@@ -141,6 +141,13 @@ void JsonDecoder::remember(KeyNode& node, size_t position, simdjson::ondemand::r
 
 void JsonDecoder::prepare(KeyNode& node) {
   for (KeyNode& c : node.children) prepare(c);
+  for (KeyNode& c : node.children) {
+    c.is_index = spec::is_index_part(c.name);
+    if (!c.is_index) continue;
+    const uint32_t i = spec::index_of_part(c.name);
+    if (node.by_index.size() <= i) node.by_index.resize(i + 1, nullptr);
+    node.by_index[i] = &c;  // children are complete: the pointers stay valid
+  }
   for (KeyNode& c : node.children) node.any_escaped_child = node.any_escaped_child || !c.raw_comparable;
   node.raw_comparable = node.name.find_first_of("\"\\") == std::string::npos;
   if (node.tests.empty() || !node.children.empty() || node.is_time) return;
@@ -241,7 +248,7 @@ bool JsonDecoder::decode_object(simdjson::ondemand::object object, KeyNode& node
     }
     if (!known) {
       for (KeyNode& c : node.children) {
-        if (c.raw_comparable && key_is(raw, c.name)) { target = &c; break; }
+        if (c.raw_comparable && !c.is_index && key_is(raw, c.name)) { target = &c; break; }
       }
       // A key written with escapes ("\u0070") is compared unescaped.
       if (!target && (node.any_escaped_child || raw_has_backslash(raw))) {
@@ -252,7 +259,7 @@ bool JsonDecoder::decode_object(simdjson::ondemand::object object, KeyNode& node
           return false;
         }
         for (KeyNode& c : node.children)
-          if (c.name == key) { target = &c; break; }
+          if (!c.is_index && c.name == key) { target = &c; break; }
       }
       remember(node, position, raw, target);
     }
@@ -266,47 +273,95 @@ bool JsonDecoder::decode_object(simdjson::ondemand::object object, KeyNode& node
       }
       continue;
     }
-    target->seen = generation_;
-    if (target->kind != Kind::General && fast_path(*target, value)) continue;
-    json_type type;
-    if (auto err = value.type().get(type)) {
+    if (!decode_value(*target, value, &node == &root_, error, warnings)) return false;
+  }
+  return true;
+}
+
+// One value of a field (or array element) some test reads: its tests, its
+// nested fields and elements, and the time.
+bool JsonDecoder::decode_value(KeyNode& target, simdjson::ondemand::value value, bool at_root, std::string& error,
+                               std::vector<std::string>* warnings) {
+  target.seen = generation_;
+  if (target.kind != Kind::General && fast_path(target, value)) return true;
+  json_type type;
+  if (auto err = value.type().get(type)) {
+    error = std::string("invalid JSON: ") + simdjson::error_message(err);
+    malformed_ = true;
+    return false;
+  }
+  if (target.is_time && at_root) {
+    double t;
+    if (type != json_type::number || value.get_double().get(t)) {
+      error = "time field \"" + options_.time_field + "\" must be a number, not " + type_name(type);
+      return false;
+    }
+    saw_time_ = true;
+    next_time_ = t;
+    // The time field may also be tested by atoms; re-reading a number is cheap.
+  }
+  if (type == json_type::object && !target.children.empty()) {
+    simdjson::ondemand::object inner;
+    if (auto err = value.get_object().get(inner)) {
+        error = std::string("invalid JSON: ") + simdjson::error_message(err);
+      malformed_ = true;
+      return false;
+    }
+    if (!decode_object(inner, target, error, warnings)) return false;
+    for (int id : target.tests)
+      if (atoms_.tests()[id].op == FOp::Present) next_[id] = 1;
+    return true;
+  }
+  if (type == json_type::array && !target.by_index.empty()) {  // {ranges[0] < 0.5}
+    simdjson::ondemand::array elements;
+    if (auto err = value.get_array().get(elements)) {
       error = std::string("invalid JSON: ") + simdjson::error_message(err);
       malformed_ = true;
       return false;
     }
-    if (target->is_time && &node == &root_) {
-      double t;
-      if (type != json_type::number || value.get_double().get(t)) {
-        error = "time field \"" + options_.time_field + "\" must be a number, not " + type_name(type);
-        return false;
-      }
-      saw_time_ = true;
-      next_time_ = t;
-      // The time field may also be tested by atoms; re-reading a number is cheap.
-    }
-    if (type == json_type::object && !target->children.empty()) {
-      simdjson::ondemand::object inner;
-      if (auto err = value.get_object().get(inner)) {
-        error = std::string("invalid JSON: ") + simdjson::error_message(err);
+    if (!decode_array(elements, target, error, warnings)) return false;
+    for (int id : target.tests)
+      if (atoms_.tests()[id].op == FOp::Present) next_[id] = 1;
+    return true;
+  }
+  if (!target.tests.empty() && !apply_tests(target, value, type, error, warnings)) return false;
+  // apply_tests reads scalars of tested fields; what it did not read (a
+  // field only its children are tested on, arrays, objects, null) must
+  // still be well-formed.
+  if (target.tests.empty() || type == json_type::array || type == json_type::object || type == json_type::null) {
+    if (auto err = validate(value)) {
+      error = "invalid JSON in field \"" + target.name + "\": " + simdjson::error_message(err);
       malformed_ = true;
-        return false;
-      }
-      if (!decode_object(inner, *target, error, warnings)) return false;
-      for (int id : target->tests)
-        if (atoms_.tests()[id].op == FOp::Present) next_[id] = 1;
-      continue;
+      return false;
     }
-    if (!target->tests.empty() && !apply_tests(*target, value, type, error, warnings)) return false;
-    // apply_tests reads scalars of tested fields; what it did not read (a
-    // field only its children are tested on, arrays, objects, null) must
-    // still be well-formed.
-    if (target->tests.empty() || type == json_type::array || type == json_type::object || type == json_type::null) {
-      if (auto err = validate(value)) {
-        error = "invalid JSON in field \"" + target->name + "\": " + simdjson::error_message(err);
+  }
+  return true;
+}
+
+// The elements of an array some tests index: each tested element decoded as a
+// value, the others only checked. An element the array does not have keeps
+// its tests' values, like a missing field.
+bool JsonDecoder::decode_array(simdjson::ondemand::array elements, KeyNode& node, std::string& error,
+                               std::vector<std::string>* warnings) {
+  size_t i = 0;
+  for (auto element : elements) {
+    simdjson::ondemand::value v;
+    if (auto err = std::move(element).get(v)) {
+      error = "invalid JSON in field \"" + node.name + "\": " + simdjson::error_message(err);
+      malformed_ = true;
+      return false;
+    }
+    KeyNode* child = i < node.by_index.size() ? node.by_index[i] : nullptr;
+    ++i;
+    if (!child) {
+      if (auto err = validate(v)) {
+        error = "invalid JSON in field \"" + node.name + "\": " + simdjson::error_message(err);
         malformed_ = true;
         return false;
       }
+      continue;
     }
+    if (!decode_value(*child, v, false, error, warnings)) return false;
   }
   return true;
 }
@@ -346,7 +401,7 @@ bool JsonDecoder::apply_tests(KeyNode& node, simdjson::ondemand::value value, js
 
 bool JsonDecoder::check_missing(const KeyNode& node, const std::string& prefix, std::string& error) const {
   for (const KeyNode& c : node.children) {
-    std::string path = prefix.empty() ? c.name : prefix + "." + c.name;
+    std::string path = prefix.empty() ? c.name : c.is_index ? prefix + c.name : prefix + "." + c.name;
     bool needed = false;
     for (int id : c.tests) needed = needed || atoms_.tests()[id].op != FOp::Present;
     if (c.seen != generation_) {

@@ -68,6 +68,8 @@ class JsonDecoder {
     Kind kind = Kind::General;
     std::vector<BoolTest> bool_tests;
     uint32_t seen = 0;               // message generation when last present (strict mode)
+    bool is_index = false;           // an array element: name "[N]"
+    std::vector<KeyNode*> by_index;  // the element children by index (null: not tested)
   };
   void prepare(KeyNode& node);
   static void remember(KeyNode& node, size_t position, simdjson::ondemand::raw_json_string raw, KeyNode* target);
@@ -75,6 +77,10 @@ class JsonDecoder {
   KeyNode* child(KeyNode& parent, const std::string& name);
   bool decode_object(simdjson::ondemand::object object, KeyNode& node, std::string& error,
                      std::vector<std::string>* warnings);
+  bool decode_value(KeyNode& target, simdjson::ondemand::value value, bool at_root, std::string& error,
+                    std::vector<std::string>* warnings);
+  bool decode_array(simdjson::ondemand::array elements, KeyNode& node, std::string& error,
+                    std::vector<std::string>* warnings);
   bool apply_tests(KeyNode& node, simdjson::ondemand::value value, simdjson::ondemand::json_type type,
                    std::string& error, std::vector<std::string>* warnings);
   bool check_missing(const KeyNode& node, const std::string& prefix, std::string& error) const;

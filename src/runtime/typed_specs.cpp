@@ -30,28 +30,49 @@ std::string list_constants(const MessageType& t) {
 std::optional<spec::Literal> check_test(const spec::FieldTest& test, const MessageType& root, bool dense,
                                         const std::string& time_field, const std::string& text) {
   if (dense && test.path.size() == 1 && test.path[0] == time_field) return std::nullopt;
+  // Walk the path: `holder` is the message whose field was named last (its
+  // constants are the ones a bare word may name), `value` the type of what
+  // the path has reached so far (a field, or an element of an array field).
   const MessageType* holder = &root;
-  const msg::Field* field = nullptr;
+  msg::FieldType value;
+  std::string reached;  // the path so far, for errors
   for (size_t i = 0; i < test.path.size(); ++i) {
-    if (!holder) {
-      throw spec::SpecError("field '" + test.key() + "': '" + test.path[i - 1] + "' is not a message", text,
+    const std::string& part = test.path[i];
+    if (spec::is_index_part(part)) {
+      if (value.array == ArrayKind::None)
+        throw spec::SpecError("field '" + test.key() + "': '" + reached + "' is " + value.to_string() +
+                                  ", not an array",
+                              text, test.column);
+      const uint32_t index = spec::index_of_part(part);
+      if (value.array != ArrayKind::Unbounded && index >= value.array_size)
+        throw spec::SpecError("field '" + test.key() + "': index " + std::to_string(index) + " is past the end of '" +
+                                  reached + "' (" + value.to_string() + ")",
+                              text, test.column);
+      value.array = ArrayKind::None;  // an element
+      value.array_size = 0;
+      reached += part;
+      continue;
+    }
+    if (i > 0) {
+      if (value.prim != Prim::Message || value.array != ArrayKind::None)
+        throw spec::SpecError("field '" + test.key() + "': '" + reached + "' is " + value.to_string() +
+                                  ", not a message",
+                              text, test.column);
+      holder = value.message;
+    }
+    const msg::Field* field = nullptr;
+    for (const auto& f : holder->fields)
+      if (f.name == part) field = &f;
+    if (!field) {
+      std::string where = i ? "'" + reached + "' (" + holder->full_name() + ")" : holder->full_name();
+      throw spec::SpecError("no field '" + part + "' in " + where + "; its fields: " + list_fields(*holder), text,
                             test.column);
     }
-    field = nullptr;
-    for (const auto& f : holder->fields)
-      if (f.name == test.path[i]) field = &f;
-    if (!field) {
-      std::string where = i ? "'" + test.path[i - 1] + "' (" + holder->full_name() + ")" : holder->full_name();
-      throw spec::SpecError("no field '" + test.path[i] + "' in " + where + "; its fields: " + list_fields(*holder),
-                            text, test.column);
-    }
-    if (i + 1 < test.path.size()) {
-      holder = field->type.prim == Prim::Message && field->type.array == ArrayKind::None ? field->type.message
-                                                                                        : nullptr;
-    }
+    value = field->type;
+    reached += (reached.empty() ? "" : ".") + part;
   }
-  const bool numeric = field->type.array == ArrayKind::None && field->type.prim != Prim::Message &&
-                       field->type.prim != Prim::String && field->type.prim != Prim::WString;
+  const bool numeric = value.array == ArrayKind::None && value.prim != Prim::Message && value.prim != Prim::String &&
+                       value.prim != Prim::WString;
   if (!numeric || test.value.kind != spec::Literal::Kind::String || !test.value.bare_word) return std::nullopt;
   const msg::Constant* c = holder->constant(test.value.text);
   if (!c) {

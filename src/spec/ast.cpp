@@ -54,9 +54,23 @@ std::string bounds_text(const Bounds& b) {
 
 }  // namespace
 
+bool is_index_part(const std::string& part) {
+  if (part.size() < 3 || part.front() != '[' || part.back() != ']') return false;
+  for (size_t i = 1; i + 1 < part.size(); ++i)
+    if (!std::isdigit(static_cast<unsigned char>(part[i]))) return false;
+  return true;
+}
+
+uint32_t index_of_part(const std::string& part) {
+  return static_cast<uint32_t>(std::stoul(part.substr(1, part.size() - 2)));
+}
+
 std::string FieldTest::key() const {
   std::string out;
-  for (size_t i = 0; i < path.size(); ++i) out += (i ? "." : "") + quote_if_needed(path[i]);
+  for (size_t i = 0; i < path.size(); ++i) {
+    if (is_index_part(path[i])) out += path[i];
+    else out += (i ? "." : "") + quote_if_needed(path[i]);
+  }
   return out;
 }
 

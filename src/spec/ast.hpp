@@ -30,10 +30,17 @@ struct Literal {
   bool bare_word = false;  // a String written without quotes ({gear: REVERSE}): may name a message constant
 };
 
+// Path parts naming an array element are written "[N]": no field name can
+// be one, since the parser refuses a quoted key of that form.
+bool is_index_part(const std::string& part);
+uint32_t index_of_part(const std::string& part);  // "[12]" -> 12
+
 // One test on one field: {p}, {p: false}, {x > 3}, {mode: "a"}, {m: *}, {id: *x}.
 struct FieldTest {
   enum class Op { Truthy, Eq, Ne, Lt, Le, Gt, Ge, Present, Bind };
-  std::vector<std::string> path;  // "a.b" -> {"a", "b"}; quoted keys stay whole
+  // "a.b" -> {"a", "b"}; quoted keys stay whole; an array element is its own
+  // part: "ranges[0].x" -> {"ranges", "[0]", "x"} (see is_index_part).
+  std::vector<std::string> path;
   Op op = Op::Truthy;
   Literal value;                  // for Eq .. Ge
   std::string variable;           // for Bind ({id: *x})

@@ -388,7 +388,12 @@ class Parser {
 
   std::string parse_key_segment() {
     skip_ws();
-    if (peek() == '"') return parse_quoted();
+    if (peek() == '"') {
+      const size_t at = pos_;
+      std::string key = parse_quoted();
+      if (is_index_part(key)) fail("a key written like an array element (\"" + key + "\") is ambiguous", at);
+      return key;
+    }
     if (!is_ident_start(peek())) {
       if (peek() == '}') fail("empty atom: expected a field name, e.g. {speed > 3}", pos_);
       fail("expected a field name", pos_);
@@ -396,6 +401,20 @@ class Parser {
     size_t start = pos_;
     while (is_ident_char(peek())) ++pos_;
     return s_.substr(start, pos_ - start);
+  }
+
+  // Array elements after a field name: {ranges[0] < 0.5}, {grid[2][3]}.
+  void parse_indexes(std::vector<std::string>& path) {
+    while (peek() == '[') {
+      const size_t open = pos_++;
+      const size_t start = pos_;
+      while (std::isdigit(static_cast<unsigned char>(peek()))) ++pos_;
+      if (pos_ == start) fail("expected an array index (0, 1, ...) after '['", pos_);
+      if (pos_ - start > 9) fail("array index too large", start);
+      if (peek() != ']') fail("expected ']' to close the index opened at column " + column_text(open), pos_);
+      ++pos_;
+      path.push_back("[" + std::to_string(std::stoul(s_.substr(start, pos_ - 1 - start))) + "]");
+    }
   }
 
   std::string parse_quoted() {
@@ -415,9 +434,11 @@ class Parser {
     skip_ws();
     t.column = column(pos_);
     t.path.push_back(parse_key_segment());
+    parse_indexes(t.path);
     while (peek() == '.') {  // nested field: {pose.position.x > 1}
       ++pos_;
       t.path.push_back(parse_key_segment());
+      parse_indexes(t.path);
     }
     skip_ws();
     size_t op_at = pos_;

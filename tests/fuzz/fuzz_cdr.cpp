@@ -40,7 +40,9 @@ struct Typed {
   rvc::engine::Checker checker{rvc::engine::TimeModel::Discrete, false, [](const rvc::engine::Verdict&) {}};
   std::unique_ptr<rvc::io::CdrDecoder> decoder;
   explicit Typed(const rvc::msg::MessageType& type) {
-    std::string spec = "{header.stamp.sec > 3} || {name == \"ab\"} || {pair}";
+    std::string spec =
+        "{header.stamp.sec > 3} || {name == \"ab\"} || {pair} || {points[1].x > 0} || {small[0] < 3} || "
+        "{words[1] == \"a\"} || {flags[2]: *}";
     if (type.name != "Mixed") {
       spec.clear();
       for (const auto& f : type.fields) spec += (spec.empty() ? "{" : " || {") + f.name + ": *}";

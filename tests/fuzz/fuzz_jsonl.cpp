@@ -96,7 +96,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const size_t chunk = (flags & 8) ? 16 : 1 << 20;
   const std::vector<PropertySpec> alone = {{"a", "{x > 0} since ({y} or {s == \"w\"})"}};
   const std::vector<PropertySpec> both = {{"a", "{x > 0} since ({y} or {s == \"w\"})"},
-                                          {"b", "once[1:3] ({u.v == \"w\"} or {z} or {u.k: *})"}};
+                                          {"b", "once[1:3] ({u.v == \"w\"} or {z} or {u.k: *} or {r[1] > 2} or {u.l[0].m})"}};
   Result a = run_file(alone, o, text, chunk);
   Result b = run_file(both, o, text, chunk);
   // Strict mode rejects messages that lack a tested field: then the property
