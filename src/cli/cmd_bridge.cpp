@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "cli/commands.hpp"
+#include "cli/type_options.hpp"
 #include "msg/type_registry.hpp"
 #include "cli/transport_flags.hpp"
 #include "io/json_writer.hpp"
@@ -40,24 +41,14 @@ struct BridgeCommand {
   double wait_timeout = 30;
   bool exit_on_eos = false;
   double stats_interval = 0;
-  std::string type;  // --type: dds: endpoints are topics of this ROS 2 type; zenoh: ones carry its CDR
-  std::vector<std::string> msg_paths;
-  msg::TypeRegistry registry;
+  TypeOptions typed;  // --type: dds: endpoints are topics of this ROS 2 type; zenoh: ones carry its CDR
 
   int run() {
     if (uris.size() < 2 || uris.size() % 2 != 0) {
       std::fprintf(stderr, "rvc bridge: give endpoints in pairs: FROM TO [FROM TO]...\n");
       return kUsage;
     }
-    if (!type.empty()) {
-      for (const auto& p : msg_paths) registry.add_search_path(p);
-      const msg::MessageType& t = registry.resolve(type);
-#ifdef RVC_HAVE_DDS
-      transports.dds.ros_type = &t;
-#else
-      (void)t;
-#endif
-    }
+    typed.resolve(transports);
     std::vector<std::unique_ptr<Route>> routes;
     for (size_t i = 0; i < uris.size(); i += 2) {
       // A route whose output reaches its own input (or another route's
@@ -156,11 +147,9 @@ Runner register_bridge(CLI::App& app) {
   sub->add_option("--wait-timeout", cmd->wait_timeout, "Seconds to wait for them")->capture_default_str();
   sub->add_flag("--exit-on-eos", cmd->exit_on_eos, "Exit once every route forwarded an end-of-stream marker");
   sub->add_option("--stats-interval", cmd->stats_interval, "Print forwarded counts every S seconds (stderr)");
-  sub->add_option("--type", cmd->type,
+  cmd->typed.add_to(*sub,
                   "ROS 2 message type of the samples, pkg/msg/Name: dds: endpoints are topics of this type (as ROS 2 "
                   "nodes publish them), zenoh: endpoints carry their CDR (as zenoh-bridge-ros2dds does)");
-  sub->add_option("--msg-path", cmd->msg_paths,
-                  "Folder of .msg definitions for --type: a ROS 2 share/ tree or a plain folder (repeatable)");
   add_transport_options(*sub, cmd->transports);
   return [cmd] { return cmd->run(); };
 }

@@ -16,6 +16,7 @@
 #include "cli/signals.hpp"
 #include "cli/transport_flags.hpp"
 #include "io/cdr_codec.hpp"
+#include "cli/type_options.hpp"
 #include "msg/type_registry.hpp"
 #include "transport/frame_queue.hpp"
 #include "transport/transport_options.hpp"
@@ -26,12 +27,10 @@ namespace {
 struct EchoCommand {
   transport::TransportOptions transports;
   std::string input;
-  std::string type;
-  std::vector<std::string> msg_paths;
+  TypeOptions typed;  // --type, --msg-path
   uint64_t count = 0;        // 0: no limit
   double idle_timeout = 0;   // 0: none
   std::vector<std::string> fields;  // --field: only these paths of a typed sample
-  msg::TypeRegistry registry;
 
   // --field a.b.c: each part a field of the message the previous one names.
   static bool select(const msg::MessageType& type, const std::string& path, io::CdrSelection& selection) {
@@ -64,19 +63,11 @@ struct EchoCommand {
   }
 
   int run() {
-    const msg::MessageType* ros_type = nullptr;
-    if (!type.empty()) {
-      const std::string scheme = transport::scheme_of(input);
-      if (scheme != "dds" && scheme != "zenoh") {
-        std::fprintf(stderr, "rvc: --type reads dds: or zenoh: inputs; for CDR in a file use `rvc msg decode`\n");
-        return kUsage;
-      }
-      for (const auto& p : msg_paths) registry.add_search_path(p);
-      ros_type = &registry.resolve(type);
-#ifdef RVC_HAVE_DDS
-      transports.dds.ros_type = ros_type;
-#endif
+    if (typed.given() && !TypeOptions::typed_scheme(input)) {
+      std::fprintf(stderr, "rvc: --type reads dds: or zenoh: inputs; for CDR in a file use `rvc msg decode`\n");
+      return kUsage;
     }
+    const msg::MessageType* ros_type = typed.resolve(transports);
     io::CdrSelection selection;
     if (!fields.empty() && !ros_type) {
       std::fprintf(stderr, "rvc: --field selects fields of typed samples: give --type too\n");
@@ -151,9 +142,7 @@ Runner register_echo(CLI::App& app) {
   auto cmd = std::make_shared<EchoCommand>();
   CLI::App* sub = app.add_subcommand("echo", "Print the messages of an endpoint as JSON lines (typed ROS 2 topics with --type)");
   sub->add_option("input", cmd->input, "Endpoint: dds:TOPIC, zenoh:KEYEXPR, file:PATH")->required();
-  sub->add_option("--type", cmd->type, "ROS 2 message type of the samples, pkg/msg/Name (`rvc msg list`)");
-  sub->add_option("--msg-path", cmd->msg_paths,
-                  "Folder of .msg definitions for --type: a ROS 2 share/ tree or a plain folder (repeatable)");
+  cmd->typed.add_to(*sub, "ROS 2 message type of the samples, pkg/msg/Name (`rvc msg list`)");
   sub->add_option("--field", cmd->fields,
                   "Print only this field of each typed sample, e.g. status.twist (repeatable; the rest is still "
                   "checked)");

@@ -13,6 +13,7 @@
 #include "cli/transport_flags.hpp"
 #include "cli/signals.hpp"
 #include "io/json_writer.hpp"
+#include "cli/type_options.hpp"
 #include "msg/type_registry.hpp"
 #include "runtime/monitor_loop.hpp"
 #ifdef RVC_HAVE_MCAP
@@ -36,9 +37,7 @@ struct MonitorCommand {
   size_t queue_capacity = 1 << 14;
   size_t wait_subscribers = 0;  // per network output, before subscribing to the input
   double wait_timeout = 10;
-  std::string type;                    // --type: payloads are CDR samples of this ROS 2 type
-  std::vector<std::string> msg_paths;  // --msg-path
-  msg::TypeRegistry registry;          // owns the type the pipeline decodes
+  TypeOptions typed;                   // --type: payloads are CDR samples of this ROS 2 type
   std::string topic;                   // --topic: of an mcap: input
 
   // A ROS 2 bag: played through the runtime at once, its topic's type from
@@ -46,11 +45,11 @@ struct MonitorCommand {
   int run_bag(const std::vector<engine::PropertySpec>& properties, runtime::PipelineOptions popts,
               runtime::VerdictOutputs& verdicts) {
 #ifdef RVC_HAVE_MCAP
-    if (!type.empty()) {
+    if (typed.given()) {
       std::fprintf(stderr, "rvc: a bag names the type of each topic itself: drop --type\n");
       return kUsage;
     }
-    const runtime::BagInput bag = runtime::select_bag_topic(input.substr(5), topic, registry);
+    const runtime::BagInput bag = runtime::select_bag_topic(input.substr(5), topic, typed.registry);
     popts.type = bag.type;
     popts.position_name = "message";
     runtime::Pipeline pipeline(properties, popts, [&](const engine::Verdict& v) { verdicts.put(v); });
@@ -126,19 +125,13 @@ struct MonitorCommand {
       return kUsage;
     }
     transport::TransportOptions input_transports = transports;  // outputs stay std_msgs/String
-    if (!type.empty()) {
-      const std::string scheme = transport::scheme_of(input);
-      if (scheme != "zenoh" && scheme != "dds") {
-        std::fprintf(stderr, "rvc: --type reads typed samples from a dds: topic or CDR payloads from a zenoh: key (as "
-                             "zenoh-bridge-ros2dds forwards them); %s inputs carry JSON\n", scheme.c_str());
-        return kUsage;
-      }
-      for (const auto& p : msg_paths) registry.add_search_path(p);
-      popts.type = &registry.resolve(type);
-#ifdef RVC_HAVE_DDS
-      input_transports.dds.ros_type = popts.type;
-#endif
+    if (typed.given() && !TypeOptions::typed_scheme(input)) {
+      std::fprintf(stderr, "rvc: --type reads typed samples from a dds: topic or CDR payloads from a zenoh: key (as "
+                           "zenoh-bridge-ros2dds forwards them); %s inputs carry JSON\n",
+                   transport::scheme_of(input).c_str());
+      return kUsage;
     }
+    popts.type = typed.resolve(input_transports);
     runtime::Pipeline pipeline(properties, popts, [&](const engine::Verdict& v) { verdicts.put(v); });
 
     runtime::LoopOptions lopts;
@@ -189,10 +182,8 @@ Runner register_monitor(CLI::App& app) {
                   "Before reading the input, wait for this many subscribers on each zenoh:/dds: output")
       ->capture_default_str();
   sub->add_option("--wait-timeout", cmd->wait_timeout, "Seconds to wait for them")->capture_default_str();
-  sub->add_option("--type", cmd->type,
-                  "ROS 2 message type of the input's CDR payloads, pkg/msg/Name (`rvc msg list`, `rvc msg show`)");
-  sub->add_option("--msg-path", cmd->msg_paths,
-                  "Folder of .msg definitions for --type: a ROS 2 share/ tree or a plain folder (repeatable)");
+  cmd->typed.add_to(*sub,
+                    "ROS 2 message type of the input's CDR payloads, pkg/msg/Name (`rvc msg list`, `rvc msg show`)");
   sub->add_option("--topic", cmd->topic, "With --input mcap:BAG: the topic to check (if the bag holds several)");
   sub->add_option("--queue", cmd->queue_capacity, "Messages buffered between transport and engine")->capture_default_str();
   add_transport_options(*sub, cmd->transports);

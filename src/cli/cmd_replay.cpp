@@ -20,6 +20,7 @@
 #include "cli/signals.hpp"
 #include "io/cdr_codec.hpp"
 #include "io/json_writer.hpp"
+#include "cli/type_options.hpp"
 #include "msg/type_registry.hpp"
 #include "transport/transport_options.hpp"
 
@@ -37,10 +38,8 @@ struct ReplayCommand {
   bool progress = true;
   size_t batch = 1;          // messages (lines) per published sample
   std::string latency_from;  // verdict endpoint of a monitor run with --all: measure publish -> verdict
-  std::string type;          // --type: each line is a message of this ROS 2 type, published as CDR
-  std::vector<std::string> msg_paths;
+  TypeOptions typed;         // --type: each line is a message of this ROS 2 type, published as CDR
   bool big_endian = false;
-  msg::TypeRegistry registry;
 
   static double wall_now() {
     return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
@@ -60,10 +59,8 @@ struct ReplayCommand {
         return kUsage;
       }
     }
-    const msg::MessageType* ros_type = nullptr;
-    if (!type.empty()) {
-      const std::string scheme = transport::scheme_of(to);
-      if (scheme != "zenoh" && scheme != "dds") {
+    if (typed.given()) {
+      if (!TypeOptions::typed_scheme(to)) {
         std::fprintf(stderr, "rvc: --type publishes typed samples to dds: or zenoh: endpoints; for CDR in a file "
                              "use `rvc msg encode`\n");
         return kUsage;
@@ -72,12 +69,8 @@ struct ReplayCommand {
         std::fprintf(stderr, "rvc: --type publishes one message per sample: --batch cannot be used with it\n");
         return kUsage;
       }
-      for (const auto& p : msg_paths) registry.add_search_path(p);
-      ros_type = &registry.resolve(type);
-#ifdef RVC_HAVE_DDS
-      transports.dds.ros_type = ros_type;
-#endif
     }
+    const msg::MessageType* ros_type = typed.resolve(transports);
     std::FILE* in = file == "-" ? stdin : std::fopen(file.c_str(), "r");
     if (!in) {
       std::fprintf(stderr, "rvc: cannot open '%s'\n", file.c_str());
@@ -278,11 +271,9 @@ Runner register_replay(CLI::App& app) {
   sub->add_flag("!--no-progress", cmd->progress, "No progress line on a terminal");
   sub->add_option("--latency-from", cmd->latency_from,
                   "Verdict endpoint of an `rvc monitor --all`: report publish-to-verdict latency percentiles");
-  sub->add_option("--type", cmd->type,
+  cmd->typed.add_to(*sub,
                   "ROS 2 message type of the lines, pkg/msg/Name: each line is converted to a CDR sample and published "
                   "typed (`rvc msg list`)");
-  sub->add_option("--msg-path", cmd->msg_paths,
-                  "Folder of .msg definitions for --type: a ROS 2 share/ tree or a plain folder (repeatable)");
   sub->add_flag("--big-endian", cmd->big_endian, "With --type: big-endian CDR (default: little endian)");
   add_transport_options(*sub, cmd->transports);
   return [cmd] { return cmd->run(); };

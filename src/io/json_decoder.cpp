@@ -208,6 +208,15 @@ JsonDecoder::KeyNode* JsonDecoder::child(KeyNode& parent, const std::string& nam
   return &parent.children.back();
 }
 
+// The message is malformed JSON (not merely unusable): the reader re-reads
+// it and reports it. `field`: where, if known.
+bool JsonDecoder::invalid(std::string& error, simdjson::error_code err, const std::string& field) {
+  error = field.empty() ? std::string("invalid JSON: ") + simdjson::error_message(err)
+                        : "invalid JSON in field \"" + field + "\": " + simdjson::error_message(err);
+  malformed_ = true;
+  return false;
+}
+
 bool JsonDecoder::decode(simdjson::ondemand::object object, std::string& error, std::vector<std::string>* warnings) {
   std::copy(current_.begin(), current_.end(), next_.begin());  // (memcpy of no atoms: null pointers)
   for (int id : presence_tests_) next_[id] = 0;
@@ -230,9 +239,7 @@ bool JsonDecoder::decode_object(simdjson::ondemand::object object, KeyNode& node
   for (auto field_result : object) {
     simdjson::ondemand::field field;
     if (auto err = std::move(field_result).get(field)) {
-      error = std::string("invalid JSON: ") + simdjson::error_message(err);
-      malformed_ = true;
-      return false;
+      return invalid(error, err);
     }
     // Compare the raw key bytes (no unescaping, no copy); names that contain
     // a quote or backslash fall back to comparing the unescaped key.
@@ -254,9 +261,7 @@ bool JsonDecoder::decode_object(simdjson::ondemand::object object, KeyNode& node
       if (!target && (node.any_escaped_child || raw_has_backslash(raw))) {
         std::string_view key;
         if (auto err = field.unescaped_key().get(key)) {
-          error = std::string("invalid JSON: ") + simdjson::error_message(err);
-          malformed_ = true;
-          return false;
+          return invalid(error, err);
         }
         for (KeyNode& c : node.children)
           if (!c.is_index && c.name == key) { target = &c; break; }
@@ -267,9 +272,7 @@ bool JsonDecoder::decode_object(simdjson::ondemand::object object, KeyNode& node
     simdjson::ondemand::value value = field.value();
     if (!target) {  // a field no test reads: only checked to be well-formed
       if (auto err = validate(value)) {
-        error = "invalid JSON in field \"" + key_text(raw) + "\": " + simdjson::error_message(err);
-        malformed_ = true;
-        return false;
+        return invalid(error, err, key_text(raw));
       }
       continue;
     }
@@ -286,9 +289,7 @@ bool JsonDecoder::decode_value(KeyNode& target, simdjson::ondemand::value value,
   if (target.kind != Kind::General && fast_path(target, value)) return true;
   json_type type;
   if (auto err = value.type().get(type)) {
-    error = std::string("invalid JSON: ") + simdjson::error_message(err);
-    malformed_ = true;
-    return false;
+    return invalid(error, err);
   }
   if (target.is_time && at_root) {
     double t;
@@ -303,9 +304,7 @@ bool JsonDecoder::decode_value(KeyNode& target, simdjson::ondemand::value value,
   if (type == json_type::object && !target.children.empty()) {
     simdjson::ondemand::object inner;
     if (auto err = value.get_object().get(inner)) {
-        error = std::string("invalid JSON: ") + simdjson::error_message(err);
-      malformed_ = true;
-      return false;
+      return invalid(error, err);
     }
     if (!decode_object(inner, target, error, warnings)) return false;
     for (int id : target.tests)
@@ -315,9 +314,7 @@ bool JsonDecoder::decode_value(KeyNode& target, simdjson::ondemand::value value,
   if (type == json_type::array && !target.by_index.empty()) {  // {ranges[0] < 0.5}
     simdjson::ondemand::array elements;
     if (auto err = value.get_array().get(elements)) {
-      error = std::string("invalid JSON: ") + simdjson::error_message(err);
-      malformed_ = true;
-      return false;
+      return invalid(error, err);
     }
     if (!decode_array(elements, target, error, warnings)) return false;
     for (int id : target.tests)
@@ -330,9 +327,7 @@ bool JsonDecoder::decode_value(KeyNode& target, simdjson::ondemand::value value,
   // still be well-formed.
   if (target.tests.empty() || type == json_type::array || type == json_type::object || type == json_type::null) {
     if (auto err = validate(value)) {
-      error = "invalid JSON in field \"" + target.name + "\": " + simdjson::error_message(err);
-      malformed_ = true;
-      return false;
+      return invalid(error, err, target.name);
     }
   }
   return true;
@@ -347,17 +342,13 @@ bool JsonDecoder::decode_array(simdjson::ondemand::array elements, KeyNode& node
   for (auto element : elements) {
     simdjson::ondemand::value v;
     if (auto err = std::move(element).get(v)) {
-      error = "invalid JSON in field \"" + node.name + "\": " + simdjson::error_message(err);
-      malformed_ = true;
-      return false;
+      return invalid(error, err, node.name);
     }
     KeyNode* child = i < node.by_index.size() ? node.by_index[i] : nullptr;
     ++i;
     if (!child) {
       if (auto err = validate(v)) {
-        error = "invalid JSON in field \"" + node.name + "\": " + simdjson::error_message(err);
-        malformed_ = true;
-        return false;
+        return invalid(error, err, node.name);
       }
       continue;
     }

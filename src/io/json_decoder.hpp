@@ -77,6 +77,7 @@ class JsonDecoder {
   KeyNode* child(KeyNode& parent, const std::string& name);
   bool decode_object(simdjson::ondemand::object object, KeyNode& node, std::string& error,
                      std::vector<std::string>* warnings);
+  bool invalid(std::string& error, simdjson::error_code err, const std::string& field = {});
   bool decode_value(KeyNode& target, simdjson::ondemand::value value, bool at_root, std::string& error,
                     std::vector<std::string>* warnings);
   bool decode_array(simdjson::ondemand::array elements, KeyNode& node, std::string& error,
