@@ -3,6 +3,8 @@
 // Table-3 types. Side by side in one run, same properties, same values:
 //   json   Pipeline::feed(JSON payload)             (rvc's JSON path)
 //   typed  Pipeline::feed(CDR payload), --type T   (CDR straight into the tests' values)
+//   via    cdr_to_json (tested fields only) + the JSON path: the typed path
+//          before io::CdrDecoder, kept here to measure the change side by side
 //   decode cdr_to_json alone                        (what `rvc echo` pays per sample)
 // Prints a markdown table (ns per message, typed/json ratio) and writes it as
 // JSON lines to the file given as argument (default bench/results/cdr.jsonl).
@@ -64,6 +66,28 @@ double run(const rvc::msg::MessageType* type, const std::vector<rvc::engine::Pro
   return s * 1e9 / payloads.size();
 }
 
+// The previous typed path: CDR -> JSON of the tested fields -> JSON decoder.
+double run_via_json(const rvc::msg::MessageType& type, const std::vector<rvc::engine::PropertySpec>& props,
+                    const std::vector<std::string>& samples, uint64_t& verdicts) {
+  rvc::runtime::PipelineOptions o;
+  o.emit_all = true;
+  verdicts = 0;
+  rvc::runtime::Pipeline p(props, o, [&](const rvc::engine::Verdict&) { ++verdicts; });
+  rvc::io::CdrSelection selection;
+  for (const auto& t : p.checker().atoms().tests()) selection.add(t.path);
+  std::string json;
+  rvc::io::CdrError e;
+  const auto t0 = Clock::now();
+  uint64_t seq = 0;
+  for (const auto& s : samples) {
+    json.clear();
+    rvc::io::cdr_to_json(type, s, json, e, &selection);
+    p.feed(json, ++seq);
+  }
+  const double s = std::chrono::duration<double>(Clock::now() - t0).count();
+  return s * 1e9 / samples.size();
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -83,8 +107,10 @@ int main(int argc, char** argv) {
   std::FILE* out = nullptr;
   std::filesystem::create_directories(std::filesystem::path(out_path).parent_path());
   out = std::fopen(out_path.c_str(), "w");
-  std::printf("| type | bytes JSON / CDR | json ns/msg | typed ns/msg | typed / json | cdr_to_json ns/msg |\n");
-  std::printf("|------|------------------|-------------|--------------|--------------|--------------------|\n");
+  std::printf("| type | bytes JSON / CDR | json ns/msg | typed ns/msg | typed / json | via JSON ns/msg | via JSON / json "
+              "| cdr_to_json ns/msg |\n");
+  std::printf("|------|------------------|-------------|--------------|--------------|-----------------|-----------------"
+              "|--------------------|\n");
   for (const auto& c : cases) {
     const auto& type = registry.resolve(c.type);
     std::mt19937_64 rng(7);
@@ -105,7 +131,9 @@ int main(int argc, char** argv) {
     run(nullptr, c.properties, json, v_json);  // warm-up
     const double ns_json = run(nullptr, c.properties, json, v_json);
     const double ns_typed = run(&type, c.properties, cdr, v_typed);
-    if (v_json != v_typed) {
+    uint64_t v_via = 0;
+    const double ns_via = run_via_json(type, c.properties, cdr, v_via);
+    if (v_json != v_typed || v_json != v_via) {
       std::fprintf(stderr, "cdr_bench: %s: %llu verdicts from JSON, %llu from CDR\n", c.type,
                    (unsigned long long)v_json, (unsigned long long)v_typed);
       return 1;
@@ -118,8 +146,9 @@ int main(int argc, char** argv) {
       rvc::io::cdr_to_json(type, s, decoded, e);
     }
     const double ns_decode = std::chrono::duration<double, std::nano>(Clock::now() - t0).count() / kMessages;
-    std::printf("| %s | %.0f / %.0f | %.0f | %.0f | %.2f | %.0f |\n", c.type, double(json_bytes) / kMessages,
-                double(cdr_bytes) / kMessages, ns_json, ns_typed, ns_typed / ns_json, ns_decode);
+    std::printf("| %s | %.0f / %.0f | %.0f | %.0f | %.2f | %.0f | %.2f | %.0f |\n", c.type,
+                double(json_bytes) / kMessages, double(cdr_bytes) / kMessages, ns_json, ns_typed, ns_typed / ns_json,
+                ns_via, ns_via / ns_json, ns_decode);
     if (out) {
       rvc::io::JsonObject o;
       o.add("type", std::string(c.type))
@@ -127,6 +156,8 @@ int main(int argc, char** argv) {
           .add_fixed("json_ns_per_msg", ns_json, 1)
           .add_fixed("typed_ns_per_msg", ns_typed, 1)
           .add_fixed("typed_over_json", ns_typed / ns_json, 3)
+          .add_fixed("via_json_ns_per_msg", ns_via, 1)
+          .add_fixed("via_json_over_json", ns_via / ns_json, 3)
           .add_fixed("cdr_to_json_ns_per_msg", ns_decode, 1);
       std::fprintf(out, "%s\n", o.str().c_str());
     }

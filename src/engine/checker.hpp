@@ -38,6 +38,7 @@ class Checker {
   void add_property(const PropertySpec& property);
 
   AtomTable& atoms() { return atoms_; }
+  const AtomTable& atoms() const { return atoms_; }
   TimeModel model() const { return model_; }
   size_t size() const { return names_.size(); }
   const std::vector<std::string>& names() const { return names_; }
