@@ -12,6 +12,7 @@
 #include "msg/type_registry.hpp"
 #include "runtime/check_stream.hpp"
 #ifdef RVC_HAVE_MCAP
+#include "cli/bag_run.hpp"
 #include "runtime/check_bag.hpp"
 #include "transport/mcap/mcap_bag.hpp"
 #endif
@@ -27,7 +28,8 @@ struct CheckCommand {
   std::string input;
   std::string output = "-";
   bool summary = false;
-  std::string topic;  // --topic: which topic of a bag
+  std::vector<std::string> topics;  // --topic: which topic(s) of a bag
+  SyncFlags sync;                   // several topics
   msg::TypeRegistry registry;  // types from a bag's schemas
 
   int run() {
@@ -39,7 +41,7 @@ struct CheckCommand {
     }
     const bool bag = input.rfind("mcap:", 0) == 0;
     if (bag || (path != "-" && is_bag(path))) return run_bag(properties, bag ? input.substr(5) : path, opath);
-    if (!topic.empty()) {
+    if (!topics.empty()) {
       std::fprintf(stderr, "rvc: --topic chooses a topic of a bag (MCAP); '%s' is a JSON-lines trace\n",
                    path.c_str());
       return kUsage;
@@ -62,7 +64,7 @@ struct CheckCommand {
     // Reading stdin: show each verdict as soon as it is known.
     runtime::Outcome outcome = runtime::check_stream(fd, pipeline, outputs, ropts, path == "-");
     if (fd != 0) ::close(fd);
-    report(pipeline);
+    report(pipeline.stats(), pipeline.violations());
     return outcome.exit_code();
   }
 
@@ -75,24 +77,17 @@ struct CheckCommand {
 #endif
   }
 
-  // A ROS 2 bag: one topic, its type from the bag's own schema.
+  // A ROS 2 bag: its types from the bag's own schemas.
   int run_bag(const std::vector<engine::PropertySpec>& properties, const std::string& path,
               const std::string& opath) {
 #ifdef RVC_HAVE_MCAP
-    const runtime::BagInput bag = runtime::select_bag_topic(path, topic, registry);
-    runtime::PipelineOptions popts = check.pipeline_options();
-    popts.type = bag.type;
-    popts.position_name = "message";
     std::vector<std::unique_ptr<transport::Sink>> sinks;
     sinks.push_back(std::make_unique<transport::FileSink>(opath));
     runtime::VerdictOutputs outputs(std::move(sinks), !check.dense);
-    runtime::Pipeline pipeline(properties, popts, [&](const engine::Verdict& v) { outputs.put(v); });
-    if (summary)
-      std::fprintf(stderr, "rvc check: %s, topic %s (%s, %llu messages)\n", path.c_str(), bag.topic.c_str(),
-                   bag.type ? bag.type->full_name().c_str() : "JSON", static_cast<unsigned long long>(bag.messages));
-    const runtime::Outcome outcome = runtime::check_bag(bag, pipeline, outputs);
-    report(pipeline);
-    return outcome.exit_code();
+    const BagRun run = cli::run_bag(path, topics, properties, check.pipeline_options(), sync, registry, outputs);
+    if (summary) std::fprintf(stderr, "rvc check: %s, %s\n", path.c_str(), run.description.c_str());
+    report(run.stats, run.violations);
+    return run.outcome.exit_code();
 #else
     (void)properties;
     (void)opath;
@@ -102,13 +97,12 @@ struct CheckCommand {
 #endif
   }
 
-  void report(const runtime::Pipeline& pipeline) const {
-    const auto& s = pipeline.stats();
+  void report(const runtime::PipelineStats& s, uint64_t violations) const {
     if (summary || s.rejected > 0) {
       std::fprintf(stderr, "rvc: %llu messages checked, %llu rejected, %llu warnings; %s\n",
                    static_cast<unsigned long long>(s.accepted), static_cast<unsigned long long>(s.rejected),
                    static_cast<unsigned long long>(s.warnings),
-                   pipeline.violated() ? "a property was violated" : "no property was violated");
+                   violations ? "a property was violated" : "no property was violated");
     }
   }
 };
@@ -121,7 +115,10 @@ Runner register_check(CLI::App& app) {
   cmd->check.add_to(*sub);
   sub->add_option("trace", cmd->input, "Trace: PATH, file:PATH or - for stdin (JSON lines), or a ROS 2 bag (MCAP)")
       ->required();
-  sub->add_option("--topic", cmd->topic, "The topic of a bag to check (needed when the bag holds several)");
+  sub->add_option("--topic", cmd->topics,
+                  "The topic of a bag to check (needed when the bag holds several); repeatable: NAME=TOPIC (or TOPIC, "
+                  "named by its last part), synchronized by --sync, tested as {NAME.field}");
+  cmd->sync.add_to(*sub);
   sub->add_option("--output,-o", cmd->output, "Where verdicts go: PATH, file:PATH or - (stdout)")->capture_default_str();
   sub->add_flag("--summary", cmd->summary, "Print message counts to stderr at the end");
   sub->footer(

@@ -13,11 +13,14 @@
 #include "cli/transport_flags.hpp"
 #include "cli/signals.hpp"
 #include "io/json_writer.hpp"
+#include "cli/output_sinks.hpp"
+#include "cli/sync_options.hpp"
 #include "cli/type_options.hpp"
 #include "msg/type_registry.hpp"
 #include "runtime/monitor_loop.hpp"
+#include "runtime/synced_pipeline.hpp"
 #ifdef RVC_HAVE_MCAP
-#include "runtime/check_bag.hpp"
+#include "cli/bag_run.hpp"
 #endif
 #include "transport/transport_options.hpp"
 
@@ -27,9 +30,14 @@ namespace {
 struct MonitorCommand {
   CheckOptions check;
   transport::TransportOptions transports;
-  std::string input;
+  std::vector<std::string> inputs;     // --input: one URI, or several NAME=URI
+  CLI::Option* input_option = nullptr;
+  CLI::App* app = nullptr;
+  SyncFlags sync;
+  std::string input;                   // the one input
   std::vector<std::string> outputs;
   std::string stats_output;
+  std::string sets_output;             // several inputs: also publish the sets checked
   bool exit_on_eos = false;
   size_t publishers = 1;  // --publishers: end-of-stream markers to wait for
   double idle_timeout = 0;
@@ -38,7 +46,7 @@ struct MonitorCommand {
   size_t wait_subscribers = 0;  // per network output, before subscribing to the input
   double wait_timeout = 10;
   TypeOptions typed;                   // --type: payloads are CDR samples of this ROS 2 type
-  std::string topic;                   // --topic: of an mcap: input
+  std::vector<std::string> topics;     // --topic: of an mcap: input
 
   // A ROS 2 bag: played through the runtime at once, its topic's type from
   // the bag's own schema (as `rvc check bag.mcap`).
@@ -49,28 +57,23 @@ struct MonitorCommand {
       std::fprintf(stderr, "rvc: a bag names the type of each topic itself: drop --type\n");
       return kUsage;
     }
-    const runtime::BagInput bag = runtime::select_bag_topic(input.substr(5), topic, typed.registry);
-    popts.type = bag.type;
-    popts.position_name = "message";
-    runtime::Pipeline pipeline(properties, popts, [&](const engine::Verdict& v) { verdicts.put(v); });
-    std::fprintf(stderr, "rvc monitor: %zu propert%s on %s, topic %s (%s, %llu messages) -> %zu output%s\n",
-                 properties.size(), properties.size() == 1 ? "y" : "ies", input.c_str(), bag.topic.c_str(),
-                 bag.type ? bag.type->full_name().c_str() : "JSON", static_cast<unsigned long long>(bag.messages),
-                 verdicts.size(), verdicts.size() == 1 ? "" : "s");
-    const runtime::Outcome outcome = runtime::check_bag(bag, pipeline, verdicts);
-    const auto& s = pipeline.stats();
+    const std::string path = input.substr(5);
+    std::fprintf(stderr, "rvc monitor: %zu propert%s on %s -> %zu output%s\n", properties.size(),
+                 properties.size() == 1 ? "y" : "ies", input.c_str(), verdicts.size(), verdicts.size() == 1 ? "" : "s");
+    const BagRun run = cli::run_bag(path, topics, properties, popts, sync, typed.registry, verdicts);
+    std::fprintf(stderr, "rvc monitor: %s\n", run.description.c_str());
     const std::string stats = io::JsonObject()
                                   .add("input", input)
-                                  .add("topic", bag.topic)
-                                  .add("messages", bag.messages)
-                                  .add("checked", s.accepted)
-                                  .add("rejected", s.rejected)
-                                  .add("warnings", s.warnings)
+                                  .add("topic", run.topic)
+                                  .add("messages", run.messages)
+                                  .add("checked", run.stats.accepted)
+                                  .add("rejected", run.stats.rejected)
+                                  .add("warnings", run.stats.warnings)
                                   .add("verdicts", verdicts.count())
-                                  .add("violations", pipeline.checker().violations())
+                                  .add("violations", run.violations)
                                   .str();
     std::fprintf(stderr, "%s\n", stats.c_str());
-    return outcome.exit_code();
+    return run.outcome.exit_code();
 #else
     (void)properties;
     (void)popts;
@@ -83,44 +86,132 @@ struct MonitorCommand {
   // An output that the input would read back (the same file, an
   // intersecting key expression, the same topic) feeds the monitor its own
   // verdicts without end.
-  bool refuse_own_input(const std::string& output) const {
-    if (!transport::endpoints_overlap(input, output)) return false;
+  bool refuse_own_input(const std::string& output, const std::string& in) const {
+    if (!transport::endpoints_overlap(in, output)) return false;
     std::fprintf(stderr, "rvc: output '%s' would be read back by the input '%s': refusing to monitor its own output\n",
-                 output.c_str(), input.c_str());
+                 output.c_str(), in.c_str());
     return true;
+  }
+  bool refuse_own_inputs(const std::vector<std::string>& uris) const {
+    for (const auto& in : uris) {
+      for (const auto& uri : outputs)
+        if (refuse_own_input(uri, in)) return true;
+      if (!stats_output.empty() && refuse_own_input(stats_output, in)) return true;
+    }
+    return false;
+  }
+
+  int open_outputs(std::vector<std::unique_ptr<transport::Sink>>& sinks, std::unique_ptr<transport::Sink>& stats_sink) {
+    if (int status = cli::open_outputs(outputs, transports, wait_subscribers, wait_timeout, "monitor", sinks))
+      return status;
+    if (!stats_output.empty()) stats_sink = transport::open_sink(stats_output, transports);
+    return 0;
+  }
+
+  // Several named inputs: synchronized into one stream in this process.
+  int run_synced() {
+    auto properties = check.properties();
+    if (!topics.empty()) {
+      std::fprintf(stderr, "rvc: --topic chooses a topic of a bag (--input mcap:PATH)\n");
+      return kUsage;
+    }
+    std::vector<transport::TransportOptions> per_input;
+    auto named = sync.resolve(inputs, *app, input_option, typed, transports, per_input);
+    std::vector<std::string> uris, names;
+    size_t files = 0;
+    for (const auto& in : named) {
+      uris.push_back(in.uri);
+      names.push_back(in.name);
+      const std::string scheme = transport::scheme_of(in.uri);
+      if (scheme == "mcap") {
+        std::fprintf(stderr, "rvc: several topics of a bag: rvc check BAG --topic NAME=TOPIC ...\n");
+        return kUsage;
+      }
+      files += scheme == "file";
+    }
+    if (files != 0 && files != named.size()) {
+      std::fprintf(stderr, "rvc: inputs are all files or all topics, not a mix\n");
+      return kUsage;
+    }
+    if (refuse_own_inputs(uris)) return kUsage;
+    std::unique_ptr<transport::Sink> stats_sink;
+    std::vector<std::unique_ptr<transport::Sink>> sinks;
+    if (int status = open_outputs(sinks, stats_sink)) return status;
+    runtime::VerdictOutputs verdicts(std::move(sinks), !check.dense);
+    runtime::PipelineOptions popts = check.pipeline_options();
+    popts.position_name = files ? "line" : "seq";
+    // --sets-output: what the properties saw, for `rvc check` to replay.
+    std::vector<std::unique_ptr<transport::Sink>> set_sinks;
+    if (!sets_output.empty()) {
+      for (const auto& in : uris)
+        if (refuse_own_input(sets_output, in)) return kUsage;
+      set_sinks.push_back(transport::open_sink(sets_output, transports));
+    }
+    runtime::VerdictOutputs sets(std::move(set_sinks), true);
+    runtime::SetCallback on_set;
+    if (sets.size()) on_set = [&](std::string_view json, double) { sets.put_payload(json); };
+    runtime::SyncedPipeline pipeline(properties, popts, named, sync.options(named),
+                                     [&](const engine::Verdict& v) { verdicts.put(v); }, on_set);
+    runtime::LoopOptions lopts = loop_options(files != 0);
+    lopts.input_names = names;
+    lopts.input.clear();
+    for (const auto& n : names) lopts.input += (lopts.input.empty() ? "" : ",") + n;
+    runtime::MonitorLoop loop(pipeline, verdicts, stats_sink.get(), lopts);
+    std::vector<std::unique_ptr<transport::Source>> sources;
+    std::vector<transport::Source*> raw;
+    for (size_t i = 0; i < named.size(); ++i) {
+      sources.push_back(transport::open_source(named[i].uri, per_input[i]));
+      raw.push_back(sources.back().get());
+    }
+    install_stop_signals();
+    std::fprintf(stderr, "rvc monitor: %zu propert%s on %zu inputs (%s, sync %s) -> %zu output%s\n",
+                 properties.size(), properties.size() == 1 ? "y" : "ies", named.size(), lopts.input.c_str(),
+                 sync.policy.c_str(), verdicts.size(), verdicts.size() == 1 ? "" : "s");
+    runtime::Outcome outcome = loop.run(raw);
+    try {
+      sets.finish();
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "rvc: error: %s\n", e.what());
+      outcome.runtime_failure = true;
+    }
+    return outcome.exit_code();
+  }
+
+  runtime::LoopOptions loop_options(bool from_file) const {
+    runtime::LoopOptions lopts;
+    lopts.input = input;
+    // A file has nothing more to come after its end.
+    lopts.exit_on_eos = exit_on_eos || from_file;
+    lopts.publishers = publishers;
+    lopts.sequence_numbers = !from_file;
+    lopts.idle_timeout = idle_timeout;
+    lopts.stats_interval = stats_interval;
+    lopts.queue_capacity = queue_capacity;
+    lopts.stop_requested = stop_requested;
+    lopts.stats_requested = stats_requested;
+    return lopts;
   }
 
   int run() {
-    auto properties = check.properties();
     if (outputs.empty()) outputs.push_back("-");
-    for (const auto& uri : outputs)
-      if (refuse_own_input(uri)) return kUsage;
-    if (!stats_output.empty() && refuse_own_input(stats_output)) return kUsage;
-    std::vector<std::unique_ptr<transport::Sink>> sinks;
-    for (const auto& uri : outputs) sinks.push_back(transport::open_sink(uri, transports));
-    std::unique_ptr<transport::Sink> stats_sink;
-    if (!stats_output.empty()) stats_sink = transport::open_sink(stats_output, transports);
-    // Verdicts written before a subscriber has matched are lost (volatile
-    // QoS), and the first verdict follows the first input message at once:
-    // wait for the verdict subscribers before subscribing to the input.
-    for (size_t i = 0; i < sinks.size() && wait_subscribers > 0; ++i) {
-      if (transport::scheme_of(outputs[i]) == "file") continue;
-      std::fprintf(stderr, "rvc monitor: waiting for %zu subscriber%s on %s ...\n", wait_subscribers,
-                   wait_subscribers == 1 ? "" : "s", outputs[i].c_str());
-      if (!sinks[i]->wait_matched(wait_subscribers, std::chrono::milliseconds(static_cast<long>(wait_timeout * 1000)))) {
-        std::fprintf(stderr, "rvc: no subscriber matched on %s within %.1f s (--wait-timeout)\n", outputs[i].c_str(),
-                     wait_timeout);
-        if (!sinks[i]->discovery().empty())
-          std::fprintf(stderr, "rvc: this publisher: %s\n", sinks[i]->discovery().c_str());
-        return kIncomplete;
-      }
+    if (SyncFlags::named(inputs)) return run_synced();
+    const bool bag = transport::scheme_of(inputs.at(0)) == "mcap";
+    if (!bag && (!sync.stamps.empty() || app->count("--sync") || app->count("--pivot") || app->count("--lower-bound"))) {
+      std::fprintf(stderr, "rvc: --stamp, --sync, --pivot and --lower-bound synchronize several inputs: give them as "
+                           "--input NAME=URI (or several --topic of a bag)\n");
+      return kUsage;
     }
-
+    input = inputs.at(0);
+    auto properties = check.properties();
+    if (refuse_own_inputs({input})) return kUsage;
+    std::unique_ptr<transport::Sink> stats_sink;
+    std::vector<std::unique_ptr<transport::Sink>> sinks;
+    if (int status = open_outputs(sinks, stats_sink)) return status;
     runtime::VerdictOutputs verdicts(std::move(sinks), !check.dense);
     runtime::PipelineOptions popts = check.pipeline_options();
     popts.position_name = "seq";
     if (transport::scheme_of(input) == "mcap") return run_bag(properties, popts, verdicts);
-    if (!topic.empty()) {
+    if (!topics.empty()) {
       std::fprintf(stderr, "rvc: --topic chooses a topic of a bag (--input mcap:PATH)\n");
       return kUsage;
     }
@@ -134,18 +225,7 @@ struct MonitorCommand {
     popts.type = typed.resolve(input_transports);
     runtime::Pipeline pipeline(properties, popts, [&](const engine::Verdict& v) { verdicts.put(v); });
 
-    runtime::LoopOptions lopts;
-    lopts.input = input;
-    // A file has nothing more to come after its end.
-    const bool from_file = transport::scheme_of(input) == "file";
-    lopts.exit_on_eos = exit_on_eos || from_file;
-    lopts.publishers = publishers;
-    lopts.sequence_numbers = !from_file;
-    lopts.idle_timeout = idle_timeout;
-    lopts.stats_interval = stats_interval;
-    lopts.queue_capacity = queue_capacity;
-    lopts.stop_requested = stop_requested;
-    lopts.stats_requested = stats_requested;
+    runtime::LoopOptions lopts = loop_options(transport::scheme_of(input) == "file");
     runtime::MonitorLoop loop(pipeline, verdicts, stats_sink.get(), lopts);
 
     auto source = transport::open_source(input, input_transports);
@@ -162,8 +242,12 @@ Runner register_monitor(CLI::App& app) {
   auto cmd = std::make_shared<MonitorCommand>();
   CLI::App* sub = app.add_subcommand("monitor", "Monitor a topic: subscribe, check properties, publish verdicts");
   cmd->check.add_to(*sub);
-  sub->add_option("--input,-i", cmd->input, "Endpoint to monitor: zenoh:KEYEXPR, dds:TOPIC, file:PATH, - or mcap:BAG (a ROS 2 bag)")
-      ->required();
+  cmd->app = sub;
+  cmd->input_option =
+      sub->add_option("--input,-i", cmd->inputs,
+                      "Endpoint to monitor: zenoh:KEYEXPR, dds:TOPIC, file:PATH, - or mcap:BAG (a ROS 2 bag); "
+                      "several as NAME=URI (repeatable), synchronized by --sync, tested as {NAME.field}")
+          ->required();
   sub->add_option("--output,-o", cmd->outputs, "Where verdicts go (repeatable): zenoh:KEY, dds:TOPIC, file:PATH, - (default)")
       ->allow_extra_args(false);
   sub->add_flag("--exit-on-eos", cmd->exit_on_eos,
@@ -178,13 +262,19 @@ Runner register_monitor(CLI::App& app) {
       ->check(CLI::NonNegativeNumber);
   sub->add_option("--stats-interval", cmd->stats_interval, "Print counters every S seconds (also on SIGUSR1)");
   sub->add_option("--stats-output", cmd->stats_output, "Also publish the counters (JSON) to this endpoint");
+  sub->add_option("--sets-output", cmd->sets_output,
+                  "Several inputs: also publish each synchronized set (JSON, as rvc sync) to this endpoint");
   sub->add_option("--wait-subscribers", cmd->wait_subscribers,
                   "Before reading the input, wait for this many subscribers on each zenoh:/dds: output")
       ->capture_default_str();
   sub->add_option("--wait-timeout", cmd->wait_timeout, "Seconds to wait for them")->capture_default_str();
   cmd->typed.add_to(*sub,
-                    "ROS 2 message type of the input's CDR payloads, pkg/msg/Name (`rvc msg list`, `rvc msg show`)");
-  sub->add_option("--topic", cmd->topic, "With --input mcap:BAG: the topic to check (if the bag holds several)");
+                    "ROS 2 message type of the input's CDR payloads, pkg/msg/Name (`rvc msg list`, `rvc msg show`); "
+                    "several inputs: after the --input it is for, or NAME=pkg/msg/Name");
+  cmd->sync.add_to(*sub);
+  sub->add_option("--topic", cmd->topics,
+                  "With --input mcap:BAG: the topic to check (if the bag holds several); repeatable: NAME=TOPIC, "
+                  "synchronized by --sync");
   sub->add_option("--queue", cmd->queue_capacity, "Messages buffered between transport and engine")->capture_default_str();
   add_transport_options(*sub, cmd->transports);
   sub->footer(

@@ -41,6 +41,7 @@ int main(int argc, char** argv) {
   runners["bridge"] = register_bridge(app);
   runners["msg"] = register_msg(app);
   runners["echo"] = register_echo(app);
+  runners["sync"] = register_sync(app);
 #ifdef RVC_HAVE_ZENOH
   runners["router"] = register_router(app);
 #endif

@@ -18,6 +18,7 @@ struct TypeOptions {
   std::string type;                    // pkg/msg/Name; empty: JSON payloads
   std::vector<std::string> msg_paths;  // --msg-path
   msg::TypeRegistry registry;          // owns the resolved type
+  CLI::Option* type_option = nullptr;  // every --type given, in order (several inputs: one each)
 
   // `type_help` says what the type applies to in this subcommand.
   void add_to(CLI::App& app, const std::string& type_help);

@@ -53,9 +53,9 @@ BagInput select_bag_topic(const std::string& path, const std::string& topic, msg
   return in;
 }
 
-Outcome check_bag(const BagInput& input, Pipeline& pipeline, VerdictOutputs& outputs) {
-  return run_check(pipeline, outputs, [&](Outcome& outcome) {
-    transport::McapBag bag(input.path);
+Outcome check_bag(const std::vector<BagInput>& inputs, Feed& feed, VerdictOutputs& outputs) {
+  return run_check(feed, outputs, [&](Outcome& outcome) {
+    transport::McapBag bag(inputs.at(0).path);
     transport::McapMessage m;
     for (;;) {
       try {
@@ -67,9 +67,31 @@ Outcome check_bag(const BagInput& input, Pipeline& pipeline, VerdictOutputs& out
         outcome.rejected = true;
         break;
       }
-      if (m.topic == input.topic) pipeline.feed(m.data, m.index);
+      for (size_t i = 0; i < inputs.size(); ++i)
+        if (m.topic == inputs[i].topic) feed.feed_logged(static_cast<uint32_t>(i), m.data, m.index, m.log_time * 1e-9);
     }
   });
+}
+
+std::vector<SyncInput> select_bag_topics(const std::string& path, const std::vector<std::string>& topics,
+                                         msg::TypeRegistry& registry, std::vector<BagInput>& bags) {
+  std::vector<SyncInput> inputs;
+  for (const auto& text : topics) {
+    SyncInput in;
+    std::string topic = text;
+    const size_t eq = text.find('=');
+    if (eq != std::string::npos && text[0] != '/') {
+      in.name = text.substr(0, eq);
+      topic = text.substr(eq + 1);
+    } else {
+      in.name = topic.substr(topic.find_last_of('/') + 1);
+    }
+    bags.push_back(select_bag_topic(path, topic, registry));
+    in.uri = "mcap:" + path + " " + topic;
+    in.type = bags.back().type;
+    inputs.push_back(std::move(in));
+  }
+  return inputs;
 }
 
 }  // namespace rvc::runtime

@@ -5,10 +5,12 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "msg/type_registry.hpp"
 #include "runtime/exit_status.hpp"
 #include "runtime/pipeline.hpp"
+#include "runtime/synced_pipeline.hpp"
 #include "runtime/verdict_outputs.hpp"
 
 namespace rvc::runtime {
@@ -27,9 +29,17 @@ struct BagInput {
 // cannot read; transport::McapError for a file that is no bag.
 BagInput select_bag_topic(const std::string& path, const std::string& topic, msg::TypeRegistry& registry);
 
-// Feeds every message of the chosen topic to the pipeline (positions are the
-// messages' 1-based indexes in the bag, over all topics). Like check_stream,
-// never throws for a failure while running: the outcome says so.
-Outcome check_bag(const BagInput& input, Pipeline& pipeline, VerdictOutputs& outputs);
+// Feeds every message of the chosen topics to the feed in the bag's order,
+// topic i as input i, its log time as its arrival (positions are the
+// messages' 1-based indexes in the bag, over all topics). One topic: a
+// Pipeline; several: a SyncedPipeline. Like check_stream, never throws for a
+// failure while running: the outcome says so.
+Outcome check_bag(const std::vector<BagInput>& inputs, Feed& feed, VerdictOutputs& outputs);
+
+// Several topics of a bag: "NAME=TOPIC" or "TOPIC" (named by its last part,
+// "/vehicle/status/gear_status" -> gear_status). The inputs to synchronize,
+// their types from the bag; `bags` gets what check_bag needs.
+std::vector<SyncInput> select_bag_topics(const std::string& path, const std::vector<std::string>& topics,
+                                         msg::TypeRegistry& registry, std::vector<BagInput>& bags);
 
 }  // namespace rvc::runtime

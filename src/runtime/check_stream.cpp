@@ -7,18 +7,19 @@
 
 namespace rvc::runtime {
 
-Outcome run_check(Pipeline& pipeline, VerdictOutputs& outputs, const std::function<void(Outcome&)>& read) {
+Outcome run_check(Feed& feed, VerdictOutputs& outputs, const std::function<void(Outcome&)>& read) {
   Outcome outcome;
   try {
     read(outcome);
+    feed.end_of_input();
     outputs.finish();
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rvc: error: %s\n", e.what());
     outcome.runtime_failure = true;
   }
-  pipeline.finish_report();
-  outcome.violated = pipeline.violated();
-  outcome.rejected = outcome.rejected || pipeline.stats().rejected > 0;
+  feed.finish_report();
+  outcome.violated = feed.violations() > 0;
+  outcome.rejected = outcome.rejected || feed.stats().rejected > 0;
   return outcome;
 }
 

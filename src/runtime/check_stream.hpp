@@ -20,7 +20,9 @@ Outcome check_stream(int fd, Pipeline& pipeline, VerdictOutputs& outputs, io::Re
 // The frame of every check run: `read` feeds the pipeline (and may note
 // what it met in the outcome), then the outputs get their end-of-stream
 // marker. A failure while running is printed and noted, never thrown.
-Outcome run_check(Pipeline& pipeline, VerdictOutputs& outputs, const std::function<void(Outcome&)>& read);
+// After `read`, the feed learns that the input ended (a synchronizer
+// releases what it holds).
+Outcome run_check(Feed& feed, VerdictOutputs& outputs, const std::function<void(Outcome&)>& read);
 
 // True if both paths name the same existing regular file (also through links):
 // used to refuse writing verdicts over the input being read.

@@ -1,5 +1,6 @@
 #include "runtime/monitor_loop.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <stdexcept>
 #include <vector>
@@ -16,21 +17,22 @@ double wall_now() {
   return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
 }
 
-// Closes the queue, then stops the source, however run() is left.
+// Closes the queue, then stops the sources, however run() is left.
 class Shutdown {
  public:
-  Shutdown(transport::FrameQueue& queue, transport::Source& source) : queue_(queue), source_(source) {}
+  Shutdown(transport::FrameQueue& queue, const std::vector<transport::Source*>& sources)
+      : queue_(queue), sources_(sources) {}
   ~Shutdown() { now(); }
   void now() {
     if (done_) return;
     done_ = true;
     queue_.close();
-    source_.stop();
+    for (transport::Source* s : sources_) s->stop();
   }
 
  private:
   transport::FrameQueue& queue_;
-  transport::Source& source_;
+  const std::vector<transport::Source*>& sources_;
   bool done_ = false;
 };
 
@@ -47,25 +49,54 @@ const char* to_string(EndReason reason) {
   return "unknown";
 }
 
+uint64_t MonitorLoop::total(uint64_t transport::SeqCounters::*field) const {
+  uint64_t n = 0;
+  for (const auto& c : counters_) n += c.*field;
+  return n;
+}
+
+bool MonitorLoop::ended() const {
+  for (bool e : input_eos_)
+    if (!e) return false;
+  return true;
+}
+
 std::string MonitorLoop::stats_json() const {
-  const PipelineStats& p = pipeline_.stats();
-  return io::JsonObject()
-      .add("input", options_.input)
-      .add("received", counters_.received)
+  const PipelineStats& p = feed_.stats();
+  size_t publishers = 0;
+  for (const auto& c : counters_) publishers += c.publishers();
+  io::JsonObject out;
+  out.add("input", options_.input)
+      .add("received", total(&transport::SeqCounters::received))
       .add("checked", p.accepted)
       .add("rejected", p.rejected)
       .add("warnings", p.warnings)
-      .add("gaps", counters_.gaps)
-      .add("duplicates", counters_.duplicates)
-      .add("last_seq", counters_.last_seq)
-      .add("publishers", counters_.publishers())
-      .add("publisher_restarts", counters_.restarts)
+      .add("gaps", total(&transport::SeqCounters::gaps))
+      .add("duplicates", total(&transport::SeqCounters::duplicates))
+      .add("last_seq", total(&transport::SeqCounters::last_seq))
+      .add("publishers", publishers)
+      .add("publisher_restarts", total(&transport::SeqCounters::restarts))
       .add("verdicts", outputs_.count())
-      .add("violations", pipeline_.checker().violations())
-      .add("eos", eos_)
-      .add_fixed("first_at", first_at_, 6)
-      .add_fixed("done_at", wall_now(), 6)
-      .str();
+      .add("violations", feed_.violations())
+      .add("eos", eos_);
+  if (!options_.input_names.empty()) {
+    io::JsonArray inputs;
+    for (size_t i = 0; i < counters_.size(); ++i) {
+      const auto& c = counters_[i];
+      inputs.add(io::JsonObject()
+                     .add("name", options_.input_names[i])
+                     .add("received", c.received)
+                     .add("gaps", c.gaps)
+                     .add("duplicates", c.duplicates)
+                     .add("last_seq", c.last_seq)
+                     .add("publishers", c.publishers())
+                     .add("publisher_restarts", c.restarts)
+                     .add("eos", static_cast<bool>(input_eos_[i])));
+    }
+    out.add_raw("inputs", inputs.str());
+  }
+  feed_.add_stats(out);
+  return out.add_fixed("first_at", first_at_, 6).add_fixed("done_at", wall_now(), 6).str();
 }
 
 void MonitorLoop::publish_stats() {
@@ -74,11 +105,20 @@ void MonitorLoop::publish_stats() {
   if (stats_sink_) stats_sink_->put(js, 0);
 }
 
-void MonitorLoop::process(transport::Source& source) {
-  counters_.expect(options_.publishers);
+void MonitorLoop::process(const std::vector<transport::Source*>& sources) {
+  counters_.assign(sources.size(), transport::SeqCounters{});
+  input_eos_.assign(sources.size(), false);
+  for (auto& c : counters_) c.expect(options_.publishers);
   transport::FrameQueue queue(options_.queue_capacity);
-  Shutdown shutdown(queue, source);
-  source.start([&queue](const transport::Frame& f) { queue.push(f); });
+  Shutdown shutdown(queue, sources);
+  for (size_t i = 0; i < sources.size(); ++i) {
+    const auto input = static_cast<uint32_t>(i);
+    sources[i]->start([&queue, input](const transport::Frame& f) {
+      transport::Frame tagged = f;
+      tagged.input = input;
+      queue.push(tagged);
+    });
+  }
 
   using clock = std::chrono::steady_clock;
   const auto idle_limit = std::chrono::duration<double>(options_.idle_timeout);
@@ -96,6 +136,7 @@ void MonitorLoop::process(transport::Source& source) {
     }
     const auto now = clock::now();
     if (count == 0) {
+      feed_.idle();
       outputs_.idle();
       if (options_.idle_timeout > 0 && now - last_message > idle_limit) {
         end_ = EndReason::IdleTimeout;
@@ -106,25 +147,30 @@ void MonitorLoop::process(transport::Source& source) {
       if (first_at_ == 0) first_at_ = wall_now();
       for (size_t i = 0; i < count; ++i) {
         const transport::OwnedFrame& f = batch[i];
+        transport::SeqCounters& counters = counters_[f.input];
         if (f.eos) {
-          // Several publishers: the stream ends when each has ended.
-          if (options_.sequence_numbers) counters_.on_eos(f.seq, f.publisher);
-          eos_ = !options_.sequence_numbers ||
-                 (counters_.all_ended() && counters_.publishers() >= options_.publishers);
+          // Several publishers: the input ends when each has ended.
+          if (options_.sequence_numbers) counters.on_eos(f.seq, f.publisher);
+          input_eos_[f.input] = !options_.sequence_numbers ||
+                                (counters.all_ended() && counters.publishers() >= options_.publishers);
+          if (!eos_ && ended()) {
+            eos_ = true;
+            feed_.end_of_input();
+          }
           continue;
         }
         std::string_view payload = f.payload;
         if (options_.sequence_numbers) {
-          counters_.on_seq(f.seq, f.publisher);
+          counters.on_seq(f.seq, f.publisher);
         } else if (f.seq == 1 && payload.substr(0, io::kUtf8Bom.size()) == io::kUtf8Bom) {
           // A file's byte-order mark, as `rvc check` treats it; on a line of
           // its own it leaves a blank line, which is no message.
           payload.remove_prefix(io::kUtf8Bom.size());
-          pipeline_.on_warning(io::LineError{1, 1, io::kBomStartWarning});
+          feed_.warn(io::LineError{1, 1, io::kBomStartWarning});
           if (payload.find_first_not_of(" \t\r") == std::string_view::npos) continue;
         }
-        if (!options_.sequence_numbers) ++counters_.received;
-        pipeline_.feed(payload, f.seq ? f.seq : counters_.received);
+        if (!options_.sequence_numbers) ++counters.received;
+        feed_.feed_input(f.input, payload, f.seq ? f.seq : counters.received);
       }
     }
     // Counters on request or on schedule, also while no message comes.
@@ -141,17 +187,18 @@ void MonitorLoop::process(transport::Source& source) {
   shutdown.now();
 }
 
-Outcome MonitorLoop::run(transport::Source& source) {
+Outcome MonitorLoop::run(const std::vector<transport::Source*>& sources) {
   Outcome outcome;
   try {
-    process(source);
+    process(sources);
+    feed_.end_of_input();  // also after a signal or idle timeout: what is held is checked
     outputs_.finish();
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rvc: error: %s\n", e.what());
     end_ = EndReason::Failed;
     outcome.runtime_failure = true;
   }
-  pipeline_.finish_report();
+  feed_.finish_report();
   std::string final_stats = stats_json();  // done_at: last verdict out
   std::fprintf(stderr, "%s\n", final_stats.c_str());
   if (stats_sink_) {
@@ -163,16 +210,22 @@ Outcome MonitorLoop::run(transport::Source& source) {
       outcome.runtime_failure = true;
     }
   }
-  counters_.rejected = pipeline_.stats().rejected;
-  outcome.violated = pipeline_.violated();
-  outcome.lost = counters_.gaps > 0 || counters_.duplicates > 0;
-  outcome.rejected = pipeline_.stats().rejected > 0;
+  outcome.violated = feed_.violations() > 0;
+  outcome.lost = total(&transport::SeqCounters::gaps) > 0 || total(&transport::SeqCounters::duplicates) > 0;
+  outcome.rejected = feed_.stats().rejected > 0;
   // Not a pass: nothing arrived at all, or (when the run was meant to end at
   // the publisher's end-of-stream marker) it ended some other way.
   if (end_ != EndReason::Failed) {
-    if (counters_.received == 0 && !eos_) {
+    if (total(&transport::SeqCounters::received) == 0 && !eos_) {
       std::fprintf(stderr, "rvc: nothing was received on %s (ended by %s): nothing was checked\n",
                    options_.input.c_str(), to_string(end_));
+      outcome.incomplete = true;
+    } else if (!options_.input_names.empty() && !eos_ &&
+               std::any_of(counters_.begin(), counters_.end(), [](const auto& c) { return c.received == 0; })) {
+      for (size_t i = 0; i < counters_.size(); ++i)
+        if (counters_[i].received == 0)
+          std::fprintf(stderr, "rvc: nothing was received on input '%s' (ended by %s): sets needing it never formed\n",
+                       options_.input_names[i].c_str(), to_string(end_));
       outcome.incomplete = true;
     } else if (options_.exit_on_eos && !eos_) {
       std::fprintf(stderr, "rvc: %s ended by %s before the publisher's end-of-stream marker: the stream is incomplete\n",

@@ -1,5 +1,6 @@
-// The monitor's run loop: a Source's frames -> a bounded queue -> the engine
-// thread (Pipeline) -> VerdictOutputs, with loss accounting from publisher
+// The monitor's run loop: one or more Sources' frames -> one bounded queue ->
+// the engine thread (a Feed: Pipeline, or SyncedPipeline for several inputs)
+// -> VerdictOutputs, with loss accounting from publisher
 // sequence numbers, counters on request, and an orderly end in every case:
 // end-of-stream marker, stop signal, idle timeout, or a failing output.
 //
@@ -12,9 +13,10 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "runtime/exit_status.hpp"
-#include "runtime/pipeline.hpp"
+#include "runtime/feed.hpp"
 #include "runtime/verdict_outputs.hpp"
 #include "transport/endpoint.hpp"
 #include "transport/seq_counter.hpp"
@@ -23,11 +25,13 @@ namespace rvc::runtime {
 
 struct LoopOptions {
   std::string input;             // the input's name in the counters line
+  // Several inputs: their names (counters per input); empty with one input.
+  std::vector<std::string> input_names;
   bool exit_on_eos = false;      // stop at the publisher's end-of-stream marker
   // With exit_on_eos: how many publishers' markers end the stream. A publisher
   // the monitor has not discovered yet when the others end cannot be waited
   // for otherwise (discovery is asynchronous on both DDS and Zenoh).
-  size_t publishers = 1;
+  size_t publishers = 1;  // per input
   double idle_timeout = 0;       // seconds without any message before giving up; 0: wait forever
   double stats_interval = 0;     // seconds between counter lines; 0: only on request
   size_t queue_capacity = 1 << 14;
@@ -45,28 +49,33 @@ const char* to_string(EndReason reason);
 class MonitorLoop {
  public:
   // `stats_sink` (may be null) also receives every counters line.
-  MonitorLoop(Pipeline& pipeline, VerdictOutputs& outputs, transport::Sink* stats_sink, LoopOptions options)
-      : pipeline_(pipeline), outputs_(outputs), stats_sink_(stats_sink), options_(std::move(options)) {}
+  MonitorLoop(Feed& feed, VerdictOutputs& outputs, transport::Sink* stats_sink, LoopOptions options)
+      : feed_(feed), outputs_(outputs), stats_sink_(stats_sink), options_(std::move(options)) {}
 
   // Subscribes, checks, publishes; returns what happened. Never throws for a
   // failure while running (an output that cannot be written): that ends the
   // run with runtime_failure set and the reason printed.
-  Outcome run(transport::Source& source);
+  Outcome run(transport::Source& source) { return run(std::vector<transport::Source*>{&source}); }
+  // Several inputs: frames of sources[i] are input i (LoopOptions::input_names).
+  Outcome run(const std::vector<transport::Source*>& sources);
 
   // The counters as one JSON object (also printed to stderr on request).
   std::string stats_json() const;
-  const transport::SeqCounters& counters() const { return counters_; }
+  const transport::SeqCounters& counters(size_t input = 0) const { return counters_[input]; }
   EndReason end_reason() const { return end_; }
 
  private:
   void publish_stats();
-  void process(transport::Source& source);
+  void process(const std::vector<transport::Source*>& sources);
+  bool ended() const;  // every input's publishers sent their end-of-stream markers
+  uint64_t total(uint64_t transport::SeqCounters::*field) const;
 
-  Pipeline& pipeline_;
+  Feed& feed_;
   VerdictOutputs& outputs_;
   transport::Sink* stats_sink_;
   LoopOptions options_;
-  transport::SeqCounters counters_;
+  std::vector<transport::SeqCounters> counters_ = std::vector<transport::SeqCounters>(1);
+  std::vector<bool> input_eos_ = std::vector<bool>(1);
   bool eos_ = false;
   EndReason end_ = EndReason::SourceClosed;
   double first_at_ = 0;  // wall clock of the first message (benchmarks compare across processes)

@@ -1,6 +1,7 @@
 #include "runtime/pipeline.hpp"
 
 #include <cstdio>
+#include <limits>
 
 #include "io/cdr_codec.hpp"
 #include "io/verdict_writer.hpp"
@@ -46,11 +47,26 @@ Pipeline::Pipeline(const std::vector<engine::PropertySpec>& properties, const Pi
                    engine::VerdictCallback on_verdict)
     : checker_(build(properties, with_defaults(options), std::move(on_verdict))),
       options_(with_defaults(options)),
-      decoder_(checker_.atoms(), io::DecoderOptions{options.model == engine::TimeModel::Dense, options.time_field,
-                                                    options.strict}),
+      atoms_(checker_.atoms()),
+      decoder_(atoms_, io::DecoderOptions{options.model == engine::TimeModel::Dense, options.time_field,
+                                          options.strict}),
       batch_reader_(*this, options.max_message_size) {
   if (options_.type) {
-    typed_.emplace(checker_.atoms(), *options_.type,
+    typed_.emplace(atoms_, *options_.type,
+                   io::DecoderOptions{options.model == engine::TimeModel::Dense, options_.time_field, options.strict});
+  }
+}
+
+Pipeline::Pipeline(const engine::AtomTable& atoms, const PipelineOptions& options, MessageHook hook)
+    : checker_(options.model, false, [](const engine::Verdict&) {}),
+      options_(with_defaults(options)),
+      atoms_(atoms),
+      hook_(std::move(hook)),
+      decoder_(atoms_, io::DecoderOptions{options.model == engine::TimeModel::Dense, options.time_field,
+                                          options.strict}),
+      batch_reader_(*this, options.max_message_size) {
+  if (options_.type) {
+    typed_.emplace(atoms_, *options_.type,
                    io::DecoderOptions{options.model == engine::TimeModel::Dense, options_.time_field, options.strict});
   }
 }
@@ -103,7 +119,17 @@ void Pipeline::commit() {
     ++stats_.warnings;
     report("warning: " + options_.position_name + " " + std::to_string(pending_where_->number()) + ": " + w);
   }
-  if (options_.parse_only) {
+  if (hook_) {
+    const bool timed = options_.model == engine::TimeModel::Dense;
+    const double t = timed ? message_time() : std::numeric_limits<double>::quiet_NaN();
+    if (timed && !(t >= 0 && t < std::numeric_limits<double>::infinity())) {
+      on_error(io::LineError{pending_where_->number(), 0,
+                             "time " + number(t) + " is not a time (negative, infinite or not a number)"});
+      return;
+    }
+    commit_values();
+    hook_(values(), t, pending_where_->number());
+  } else if (options_.parse_only) {
     commit_values();
   } else if (checker_.model() == engine::TimeModel::Discrete) {
     commit_values();

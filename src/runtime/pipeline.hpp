@@ -8,6 +8,7 @@
 #include <simdjson.h>
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -17,6 +18,7 @@
 #include "io/json_decoder.hpp"
 #include "io/jsonl_reader.hpp"
 #include "msg/msg_types.hpp"
+#include "runtime/feed.hpp"
 
 namespace rvc::runtime {
 
@@ -35,17 +37,22 @@ struct PipelineOptions {
   const msg::MessageType* type = nullptr;
 };
 
-struct PipelineStats {
-  uint64_t accepted = 0;  // messages fed to the monitors
-  uint64_t rejected = 0;  // messages refused (malformed, wrong time order, strict-mode problems)
-  uint64_t warnings = 0;  // fields that kept their previous value (wrong type)
-};
+// Decode-only mode (a synchronized input, see SyncedPipeline): each accepted
+// message's committed values, in the order of the atom table given to the
+// Pipeline, its time (NaN without a time field) and its position.
+using MessageHook = std::function<void(const uint8_t* values, double time, uint64_t position)>;
 
-class Pipeline final : public io::JsonlHandler {
+class Pipeline final : public io::JsonlHandler, public Feed {
  public:
   // Throws spec::SpecError (prefixed with the property's name) for a bad spec.
   Pipeline(const std::vector<engine::PropertySpec>& properties, const PipelineOptions& options,
            engine::VerdictCallback on_verdict);
+  // Decode-only: evaluates the tests of `atoms` (which must outlive the
+  // Pipeline; typed: already bound to the type) and hands every accepted
+  // message to `hook` instead of a checker. With a time field (dense model),
+  // a message whose time is negative or not a number is rejected; the order
+  // of times is left to the hook.
+  Pipeline(const engine::AtomTable& atoms, const PipelineOptions& options, MessageHook hook);
 
   io::ReadResult on_object(const io::Position& position, simdjson::ondemand::object object) override;
   std::string json_error() const override { return json_error_; }
@@ -61,11 +68,16 @@ class Pipeline final : public io::JsonlHandler {
   // payload (or line) over max_message_size is rejected, as in a file.
   void feed(std::string_view payload, uint64_t position);
 
-  const PipelineStats& stats() const { return stats_; }
+  const PipelineStats& stats() const override { return stats_; }
   const engine::Checker& checker() const { return checker_; }
   bool violated() const { return checker_.violations() > 0; }
   // Prints "N more errors were not shown" if output was cut short.
-  void finish_report();
+  void finish_report() override;
+
+  // Feed, for the monitor loop: one input.
+  void feed_input(uint32_t, std::string_view payload, uint64_t position) override { feed(payload, position); }
+  void warn(const io::LineError& warning) override { on_warning(warning); }
+  uint64_t violations() const override { return checker_.violations(); }
 
  private:
   void report(const std::string& text);
@@ -77,6 +89,8 @@ class Pipeline final : public io::JsonlHandler {
   double message_time() const { return typed_ ? typed_->time() : decoder_.time(); }
   engine::Checker checker_;
   PipelineOptions options_;
+  const engine::AtomTable& atoms_;  // the checker's, or a synchronized input's
+  MessageHook hook_;
   io::JsonDecoder decoder_;
   PipelineStats stats_;
   bool has_time_ = false;

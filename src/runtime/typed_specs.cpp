@@ -93,8 +93,9 @@ std::optional<spec::Literal> check_test(const spec::FieldTest& test, const Messa
 
 }  // namespace
 
-void bind_message_type(engine::Checker& checker, const std::vector<engine::PropertySpec>& properties,
-                       const MessageType& type, bool dense, const std::string& time_field) {
+void bind_message_type(engine::AtomTable& atoms, const std::vector<engine::PropertySpec>& properties,
+                       const MessageType& type, bool dense, const std::string& time_field,
+                       const std::string& input) {
   std::map<std::string, spec::Literal> resolved;  // canonical test text -> its value
   spec::ParseOptions options;
   options.dense = dense;
@@ -103,7 +104,14 @@ void bind_message_type(engine::Checker& checker, const std::vector<engine::Prope
       spec::NodePtr ast = spec::parse(p.spec, options);
       std::function<void(const spec::Node&)> walk = [&](const spec::Node& n) {
         if (n.op == spec::Op::Test) {
-          if (auto lit = check_test(n.test, type, dense, time_field, p.spec)) resolved[n.test.to_string()] = *lit;
+          spec::FieldTest test = n.test;
+          // One input of several: its tests, seen as the input sees them.
+          const bool mine = input.empty() || (test.path.size() > 1 && test.path[0] == input);
+          if (!input.empty() && mine) test.path.erase(test.path.begin());
+          if (mine) {
+            if (auto lit = check_test(test, type, dense && input.empty(), time_field, p.spec))
+              resolved[test.to_string()] = *lit;
+          }
         }
         if (n.left) walk(*n.left);
         if (n.right) walk(*n.right);
@@ -113,11 +121,15 @@ void bind_message_type(engine::Checker& checker, const std::vector<engine::Prope
       throw spec::SpecError("in property '" + p.name + "': " + e.message(), e.source(), e.column());
     }
   }
-  auto& atoms = checker.atoms();
   for (size_t id = 0; id < atoms.size(); ++id) {
     auto it = resolved.find(atoms.tests()[id].to_string());
     if (it != resolved.end()) atoms.set_value(static_cast<int>(id), it->second);
   }
+}
+
+void bind_message_type(engine::Checker& checker, const std::vector<engine::PropertySpec>& properties,
+                       const MessageType& type, bool dense, const std::string& time_field) {
+  bind_message_type(checker.atoms(), properties, type, dense, time_field, {});
 }
 
 }  // namespace rvc::runtime

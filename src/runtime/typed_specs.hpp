@@ -18,4 +18,12 @@ namespace rvc::runtime {
 void bind_message_type(engine::Checker& checker, const std::vector<engine::PropertySpec>& properties,
                        const msg::MessageType& type, bool dense, const std::string& time_field);
 
+// The same for one named input of several (`--input gear=dds:... --type
+// ...`): only the tests on "input.…" are checked, against `type`, and bound
+// in `atoms`, the input's own table, where they are held without the
+// "input." prefix.
+void bind_message_type(engine::AtomTable& atoms, const std::vector<engine::PropertySpec>& properties,
+                       const msg::MessageType& type, bool dense, const std::string& time_field,
+                       const std::string& input);
+
 }  // namespace rvc::runtime

@@ -12,6 +12,11 @@ void VerdictOutputs::put(const engine::Verdict& v) {
   for (auto& s : sinks_) s->put(line_, count_);
 }
 
+void VerdictOutputs::put_payload(std::string_view payload) {
+  ++count_;
+  for (auto& s : sinks_) s->put(payload, count_);
+}
+
 void VerdictOutputs::idle() {
   for (auto& s : sinks_) s->idle();
 }

@@ -22,6 +22,8 @@ class VerdictOutputs {
   // Publishes one verdict on every sink. Throws (std::runtime_error) if a
   // sink cannot take it: verdicts that cannot be delivered end the run.
   void put(const engine::Verdict& verdict);
+  // Publishes one ready payload the same way (`rvc sync`: one set as JSON).
+  void put_payload(std::string_view payload);
   // Nothing pending upstream: make buffered verdicts visible.
   void idle();
   // The end-of-stream marker, then a flush, on every sink. Throws as put().

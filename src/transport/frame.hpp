@@ -13,6 +13,7 @@ struct Frame {
   uint64_t seq = 0;          // publisher's sequence number (1-based), 0 if unknown
   bool eos = false;          // end-of-stream marker: payload is empty, seq = last data seq
   uint64_t publisher = 0;    // who sent it (DDS publication handle, rvc's Zenoh publisher id); 0 if unknown
+  uint32_t input = 0;        // which input of several (set by the monitor loop, not by transports)
 };
 
 // Called on a transport thread. Must copy what it keeps and return quickly.

@@ -23,6 +23,7 @@ struct OwnedFrame {
   uint64_t seq = 0;
   bool eos = false;
   uint64_t publisher = 0;
+  uint32_t input = 0;
 };
 
 class FrameQueue {
@@ -40,6 +41,7 @@ class FrameQueue {
     slot.seq = frame.seq;
     slot.eos = frame.eos;
     slot.publisher = frame.publisher;
+    slot.input = frame.input;
     if (incoming_count_ == 1) not_empty_.notify_one();
   }
 

@@ -117,6 +117,40 @@ def test_choosing_the_topic(rvc, tmp_path, typestore):
     assert r.returncode == 2 and "--topic chooses a topic of a bag" in r.stderr
 
 
+def test_several_topics_of_a_bag_in_one_run(rvc, tmp_path, typestore):
+    """--topic NAME=TOPIC twice: the two topics merged by their stamps into one stream, tested as
+    {gear.…} and {steer.…}. Oracle: the merge written out here (each message an event at its stamp,
+    the other topic's latest value held) through `rvc check` as JSON, discrete and dense."""
+    gears = gear_values(50, 5)
+    steers = [(t + 13 * 10**6, random.Random(t).uniform(-0.6, 0.6)) for t, _ in gear_values(70, 6)]
+    bag = write_rosbag2(tmp_path, typestore, gears, steers)
+    f32 = lambda a: struct.unpack("<f", struct.pack("<f", a))[0]
+    events, latest = [], {}
+    for t, name, value in sorted([(t, "gear", {"report": r}) for t, r in gears] +
+                                 [(t, "steer", {"steering_tire_angle": f32(a)}) for t, a in steers]):
+        latest[name] = value
+        events.append(dict(latest, t=(float(t // 10**9) * 1e9 + float(t % 10**9)) / 1e9))
+    trace = json_trace(tmp_path, "merged.jsonl", events)
+    topics = ["--topic", f"gear={GEAR_TOPIC}", "--topic", f"steer={STEER_TOPIC}"]
+    for mode, spec, numeric in [
+        ([], "{gear.report == REVERSE} -> {steer.steering_tire_angle < 0.3}",
+         "{gear.report == 20} -> {steer.steering_tire_angle < 0.3}"),
+        (["--dense"], "historically[0:0.2]({gear.report == REVERSE} -> {steer.steering_tire_angle > -0.4})",
+         "historically[0:0.2]({gear.report == 20} -> {steer.steering_tire_angle > -0.4})"),
+    ]:
+        got = run([rvc, "check", "--all", *mode, "--summary", "--spec", spec, bag, *topics])
+        want = run([rvc, "check", "--all", *mode, "--time-field", "t", "--spec", numeric, trace])
+        assert got.stdout == want.stdout and '"value":false' in want.stdout, got.stderr
+        assert f"gear={GEAR_TOPIC} ({GEAR}, 50)" in got.stderr and "sync merge" in got.stderr, got.stderr
+        mon = run([rvc, "monitor", "--all", *mode, "--spec", spec, "--input", f"mcap:{bag}", *topics])
+        assert mon.stdout == want.stdout, mon.stderr
+    # A topic named by its last part; an unknown one is named with the bag's topics.
+    r = run([rvc, "check", "--spec", "{gear_status.report == 2}", bag, "--topic", GEAR_TOPIC, "--topic", STEER_TOPIC])
+    assert r.returncode in (0, 1), r.stderr
+    r = run([rvc, "check", "--spec", "{a.report == 2}", bag, "--topic", f"a={GEAR_TOPIC}", "--topic", "b=/x"])
+    assert r.returncode == 2 and "has no topic '/x'" in r.stderr, r.stderr
+
+
 @pytest.mark.parametrize("compression", ["zstd", "lz4", "none"])
 def test_mcap_writer_chunk_compressions(rvc, tmp_path, typestore, compression):
     """Foxglove's writer, each chunk compression; small chunks so the bag has many."""

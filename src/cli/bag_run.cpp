@@ -1,0 +1,42 @@
+#include "cli/bag_run.hpp"
+
+namespace rvc::cli {
+
+BagRun run_bag(const std::string& path, const std::vector<std::string>& topics,
+               const std::vector<engine::PropertySpec>& properties, runtime::PipelineOptions options,
+               const SyncFlags& sync, msg::TypeRegistry& registry, runtime::VerdictOutputs& outputs) {
+  BagRun run;
+  options.position_name = "message";
+  auto on_verdict = [&](const engine::Verdict& v) { outputs.put(v); };
+  if (topics.size() <= 1 && (topics.empty() || topics[0].find('=') == std::string::npos || topics[0][0] == '/')) {
+    const runtime::BagInput bag = runtime::select_bag_topic(path, topics.empty() ? "" : topics[0], registry);
+    options.type = bag.type;
+    runtime::Pipeline pipeline(properties, options, on_verdict);
+    run.messages = bag.messages;
+    run.topic = bag.topic;
+    run.description = "topic " + bag.topic + " (" + (bag.type ? bag.type->full_name() : std::string("JSON")) + ", " +
+                      std::to_string(bag.messages) + " messages)";
+    run.outcome = runtime::check_bag({bag}, pipeline, outputs);
+    run.stats = pipeline.stats();
+    run.violations = pipeline.violations();
+    return run;
+  }
+  std::vector<runtime::BagInput> bags;
+  std::vector<runtime::SyncInput> inputs = runtime::select_bag_topics(path, topics, registry, bags);
+  sync.apply_stamps(inputs);
+  runtime::SyncedPipeline pipeline(properties, options, inputs, sync.options(inputs), on_verdict);
+  for (size_t i = 0; i < bags.size(); ++i) {
+    run.messages += bags[i].messages;
+    run.topic += (i ? "," : "") + bags[i].topic;
+    run.description += std::string(i ? ", " : "topics ") + inputs[i].name + "=" + bags[i].topic + " (" +
+                       (bags[i].type ? bags[i].type->full_name() : std::string("JSON")) + ", " +
+                       std::to_string(bags[i].messages) + ")";
+  }
+  run.description += std::string(", sync ") + sync::to_string(sync.options(inputs).policy);
+  run.outcome = runtime::check_bag(bags, pipeline, outputs);
+  run.stats = pipeline.stats();
+  run.violations = pipeline.violations();
+  return run;
+}
+
+}  // namespace rvc::cli

@@ -1,0 +1,31 @@
+// Properties over a ROS 2 bag, as `rvc check BAG` and `rvc monitor --input
+// mcap:BAG` both run it: one topic through a Pipeline, several topics
+// (--topic NAME=TOPIC, repeatable) synchronized through a SyncedPipeline.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "cli/sync_options.hpp"
+#include "msg/type_registry.hpp"
+#include "runtime/check_bag.hpp"
+#include "runtime/verdict_outputs.hpp"
+
+namespace rvc::cli {
+
+struct BagRun {
+  runtime::Outcome outcome;
+  runtime::PipelineStats stats;
+  uint64_t violations = 0;
+  uint64_t messages = 0;    // of the chosen topics
+  std::string topic;        // the chosen topic (several: joined by ",")
+  std::string description;  // "topic /a (pkg/msg/T, 12 messages)", or the inputs
+};
+
+// Throws as select_bag_topic(s) for a bad choice of topics; `sync` applies
+// with several topics.
+BagRun run_bag(const std::string& path, const std::vector<std::string>& topics,
+               const std::vector<engine::PropertySpec>& properties, runtime::PipelineOptions options,
+               const SyncFlags& sync, msg::TypeRegistry& registry, runtime::VerdictOutputs& outputs);
+
+}  // namespace rvc::cli

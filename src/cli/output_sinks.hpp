@@ -1,0 +1,23 @@
+// Opening the outputs of a participant (monitor verdicts, sync sets) and
+// waiting for their subscribers first: a payload written before a subscriber
+// has matched is lost (volatile QoS), and the first one follows the first
+// input message at once.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "transport/endpoint.hpp"
+#include "transport/transport_options.hpp"
+
+namespace rvc::cli {
+
+// Opens every URI; with wait_subscribers > 0 waits for that many subscribers
+// on each network output. Returns 0, or the exit status to end with (none
+// matched in time; the reason is printed, with how this publisher is found).
+int open_outputs(const std::vector<std::string>& uris, const transport::TransportOptions& transports,
+                 size_t wait_subscribers, double wait_timeout, const char* who,
+                 std::vector<std::unique_ptr<transport::Sink>>& sinks);
+
+}  // namespace rvc::cli

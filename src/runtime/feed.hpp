@@ -1,0 +1,46 @@
+// What the monitor loop feeds messages to: one Pipeline (one input), or a
+// SyncedPipeline (several named inputs merged into one stream). The loop
+// only moves payloads and counts them; everything about decoding, ordering
+// and checking is behind this interface.
+#pragma once
+
+#include <cstdint>
+#include <string_view>
+
+#include "io/json_writer.hpp"
+#include "io/jsonl_reader.hpp"
+
+namespace rvc::runtime {
+
+struct PipelineStats {
+  uint64_t accepted = 0;  // messages fed to the monitors
+  uint64_t rejected = 0;  // messages refused (malformed, wrong time order, strict-mode problems)
+  uint64_t warnings = 0;  // fields that kept their previous value (wrong type)
+};
+
+class Feed {
+ public:
+  virtual ~Feed() = default;
+  // One payload of input `input` (0 with one input); `position` names it in
+  // errors (its sequence number, or line number for a file).
+  virtual void feed_input(uint32_t input, std::string_view payload, uint64_t position) = 0;
+  // The same for a recorded message: `log_time` (seconds) stands for its
+  // arrival (a bag's log time).
+  virtual void feed_logged(uint32_t input, std::string_view payload, uint64_t position, double log_time) {
+    (void)log_time;
+    feed_input(input, payload, position);
+  }
+  virtual void warn(const io::LineError& warning) = 0;
+  // No message is pending (the loop is waiting): time-driven work.
+  virtual void idle() {}
+  // Every input has ended (end-of-stream, file end): nothing more will come.
+  virtual void end_of_input() {}
+  virtual const PipelineStats& stats() const = 0;
+  virtual uint64_t violations() const = 0;
+  // Prints "N more errors were not shown" if output was cut short.
+  virtual void finish_report() = 0;
+  // Counters of its own beyond PipelineStats (per-input sync counters).
+  virtual void add_stats(io::JsonObject& out) const { (void)out; }
+};
+
+}  // namespace rvc::runtime

@@ -1,0 +1,362 @@
+#include "runtime/synced_pipeline.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <set>
+#include <stdexcept>
+
+#include "io/cdr_codec.hpp"
+#include "io/cdr_decoder.hpp"
+#include "runtime/typed_specs.hpp"
+#include "spec/parser.hpp"
+#include "spec/spec_error.hpp"
+
+namespace rvc::runtime {
+
+// One input: its own tests (the global ones without the "name." prefix), its
+// own decoder, and where each of its tests sits in the checker's table.
+struct SyncedPipeline::Input {
+  SyncInput spec;
+  bool arrival_stamp = false;
+  std::unique_ptr<engine::AtomTable> atoms = std::make_unique<engine::AtomTable>();
+  std::unique_ptr<Pipeline> pipeline;
+  std::vector<std::pair<int, int>> slots;  // (checker atom id, this input's atom id)
+  InputCounters counters;
+  std::string last_text;  // its latest set member as JSON (rvc sync)
+};
+
+// A message between arrival and release.
+struct SyncedPipeline::Held {
+  uint32_t input = 0;
+  bool used = false;
+  std::vector<uint8_t> values;  // in the input's atom order
+  std::string text;             // as JSON, only when sets are published
+};
+
+namespace {
+
+double wall_now() {
+  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
+
+bool is_identifier(const std::string& s) {
+  if (s.empty() || !(std::isalpha(static_cast<unsigned char>(s[0])) || s[0] == '_')) return false;
+  for (char c : s)
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_')) return false;
+  return true;
+}
+
+std::string names_of(const std::vector<SyncInput>& inputs) {
+  std::string s;
+  for (const auto& i : inputs) s += (s.empty() ? "" : ", ") + i.name;
+  return s;
+}
+
+// Every field a property tests must start with an input's name and go on
+// into that input's message: caught here with the test's column, not as a
+// field that is silently never present.
+void check_paths(const std::vector<engine::PropertySpec>& properties, const std::vector<SyncInput>& inputs,
+                 bool dense) {
+  spec::ParseOptions options;
+  options.dense = dense;
+  for (const auto& p : properties) {
+    spec::NodePtr ast = spec::parse(p.spec, options);
+    std::function<void(const spec::Node&)> walk = [&](const spec::Node& n) {
+      if (n.op == spec::Op::Test) {
+        const auto& path = n.test.path;
+        bool known = false;
+        for (const auto& i : inputs) known = known || path[0] == i.name;
+        if (!known)
+          throw spec::SpecError("in property '" + p.name + "': field '" + n.test.key() +
+                                    "' names no input; with several inputs a field is input.field (inputs: " +
+                                    names_of(inputs) + ")",
+                                p.spec, n.test.column);
+        if (path.size() < 2)
+          throw spec::SpecError("in property '" + p.name + "': '" + path[0] +
+                                    "' is an input; test one of its fields ({" + path[0] + ".field})",
+                                p.spec, n.test.column);
+      }
+      if (n.left) walk(*n.left);
+      if (n.right) walk(*n.right);
+    };
+    walk(*ast);
+  }
+}
+
+bool has_field(const msg::MessageType& type, const std::string& name) {
+  for (const auto& f : type.fields)
+    if (f.name == name) return true;
+  return false;
+}
+
+}  // namespace
+
+SyncedPipeline::SyncedPipeline(const std::vector<engine::PropertySpec>& properties, const PipelineOptions& options,
+                               std::vector<SyncInput> inputs, const SyncOptions& sync,
+                               engine::VerdictCallback on_verdict, SetCallback on_set)
+    : checker_(options.model, options.emit_all, std::move(on_verdict)),
+      options_(options),
+      sync_(sync),
+      on_set_(std::move(on_set)) {
+  if (inputs.empty()) throw std::invalid_argument("no inputs to synchronize");
+  std::set<std::string> seen;
+  for (const auto& i : inputs) {
+    if (!is_identifier(i.name))
+      throw std::invalid_argument("input name '" + i.name + "' is not a name (letters, digits, _): NAME=URI");
+    if (i.name == "time")
+      throw std::invalid_argument("input name 'time' is taken: a set's stamp is its \"time\" field");
+    if (!seen.insert(i.name).second) throw std::invalid_argument("two inputs are named '" + i.name + "'");
+  }
+  const bool dense = options.model == engine::TimeModel::Dense;
+  for (const auto& p : properties) {
+    try {
+      checker_.add_property(p);
+    } catch (const spec::SpecError& e) {
+      throw spec::SpecError("in property '" + p.name + "': " + e.message(), e.source(), e.column());
+    }
+  }
+  check_paths(properties, inputs, dense);
+
+  inputs_.resize(inputs.size());
+  for (size_t k = 0; k < inputs.size(); ++k) {
+    Input& in = inputs_[k];
+    in.spec = std::move(inputs[k]);
+    // The input's tests, as its decoder sees them.
+    const auto& tests = checker_.atoms().tests();
+    for (size_t id = 0; id < tests.size(); ++id) {
+      if (tests[id].path[0] != in.spec.name) continue;
+      spec::FieldTest local = tests[id];
+      local.path.erase(local.path.begin());
+      in.slots.emplace_back(static_cast<int>(id), in.atoms->intern(local));
+    }
+    // Its stamp.
+    std::string stamp = in.spec.stamp;
+    if (stamp.empty()) {
+      if (in.spec.type) {
+        stamp = io::CdrDecoder::default_time_field(*in.spec.type, "time");
+        if (stamp == "time" && !has_field(*in.spec.type, "time")) stamp = "arrival";
+      } else {
+        stamp = options.time_field;
+      }
+    }
+    in.arrival_stamp = stamp == "arrival";
+    PipelineOptions po = options;
+    po.model = in.arrival_stamp ? engine::TimeModel::Discrete : engine::TimeModel::Dense;
+    po.time_field = in.arrival_stamp ? "time" : stamp;
+    po.type = in.spec.type;
+    po.position_name = "input " + in.spec.name + " " + options.position_name;
+    if (in.spec.type) bind_message_type(*in.atoms, properties, *in.spec.type, dense, po.time_field, in.spec.name);
+    const auto input = static_cast<uint32_t>(k);
+    in.pipeline = std::make_unique<Pipeline>(
+        *in.atoms, po, [this, input](const uint8_t* values, double time, uint64_t position) {
+          accept(input, values, time, position);
+        });
+  }
+  combined_.assign(checker_.atoms().size(), 0);
+  sync::PolicyOptions po = sync.policy_options;
+  po.inputs = inputs_.size();
+  policy_ = sync::make_policy(sync.policy, po, *this);
+}
+
+SyncedPipeline::~SyncedPipeline() = default;
+
+size_t SyncedPipeline::inputs() const { return inputs_.size(); }
+
+const SyncedPipeline::InputCounters& SyncedPipeline::counters(size_t input) const { return inputs_[input].counters; }
+
+void SyncedPipeline::report(const std::string& text) {
+  if (reported_++ < options_.max_reported) std::fprintf(stderr, "rvc: %s\n", text.c_str());
+}
+
+void SyncedPipeline::feed_input(uint32_t input, std::string_view payload, uint64_t position) {
+  feed_at(input, payload, position, wall_now());
+}
+
+void SyncedPipeline::feed_at(uint32_t input, std::string_view payload, uint64_t position, double arrival) {
+  Input& in = inputs_[input];
+  feeding_ = input;
+  arrival_ = arrival;
+  if (first_arrival_ == 0) first_arrival_ = arrival;
+  in.counters.last_arrival = arrival;
+  // A batch of JSON lines is several messages: each is decoded (and kept as
+  // text) on its own, so a set's JSON holds one message per input.
+  if (!in.spec.type && payload.find('\n') != std::string_view::npos) {
+    size_t begin = 0;
+    while (begin < payload.size()) {
+      size_t end = payload.find('\n', begin);
+      if (end == std::string_view::npos) end = payload.size();
+      std::string_view line = payload.substr(begin, end - begin);
+      begin = end + 1;
+      if (line.find_first_not_of(" \t\r") == std::string_view::npos) continue;
+      ++in.counters.received;
+      message_ = line;
+      in.pipeline->feed(line, position);
+    }
+  } else {
+    ++in.counters.received;
+    message_ = payload;
+    in.pipeline->feed(payload, position);
+  }
+  if ((in.counters.received & 1023) == 0) check_health(arrival);
+}
+
+// A message the input's decoder accepted: held under a token until the
+// policy releases it.
+void SyncedPipeline::accept(uint32_t input, const uint8_t* values, double time, uint64_t position) {
+  (void)position;
+  Input& in = inputs_[input];
+  uint32_t token;
+  if (free_.empty()) {
+    token = static_cast<uint32_t>(held_.size());
+    held_.emplace_back();
+  } else {
+    token = free_.back();
+    free_.pop_back();
+  }
+  Held& h = held_[token];
+  h.input = input;
+  h.used = false;
+  h.values.assign(values, values + in.atoms->size());
+  h.text.clear();
+  if (on_set_) {
+    if (in.spec.type) {
+      io::CdrError error;
+      io::cdr_to_json(*in.spec.type, message_, h.text, error);  // the decoder accepted it: it converts
+    } else {
+      h.text.assign(message_.data(), message_.size());
+    }
+  }
+  ++in.counters.decoded;
+  policy_->add(sync::Member{input, in.arrival_stamp ? arrival_ : time, token});
+}
+
+void SyncedPipeline::on_set(const sync::Member* members, size_t count, double set_stamp) {
+  if (options_.model == engine::TimeModel::Dense) {
+    // Dense time needs strictly increasing times; every policy but latest
+    // guarantees it, latest follows its pivot input's own order.
+    if (has_time_ && !(set_stamp > last_time_)) {
+      ++sets_rejected_;
+      report("set at time " + std::to_string(set_stamp) + " is not after the previous set's time " +
+             std::to_string(last_time_) + " (dense time needs strictly increasing times; set skipped)");
+      return;
+    }
+    // The set closes [previous time, its time) with the previous values.
+    if (!options_.parse_only) checker_.step(has_time_ ? last_time_ : 0, set_stamp, combined_.data());
+  }
+  for (size_t m = 0; m < count; ++m) {
+    Held& h = held_[members[m].token];
+    Input& in = inputs_[members[m].input];
+    for (const auto& [global, local] : in.slots) combined_[global] = h.values[local];
+    if (!h.used) {
+      h.used = true;
+      ++in.counters.used;
+    }
+    if (on_set_) in.last_text = h.text;
+  }
+  if (options_.model == engine::TimeModel::Discrete && !options_.parse_only) checker_.step(combined_.data());
+  has_time_ = true;
+  last_time_ = set_stamp;
+  ++sets_;
+  if (on_set_) {
+    io::JsonObject set;
+    set.add("time", set_stamp);
+    for (const Input& in : inputs_)
+      if (!in.last_text.empty()) set.add_raw(in.spec.name, in.last_text);
+    json_ = set.str();
+    on_set_(json_, set_stamp);
+  }
+}
+
+void SyncedPipeline::on_release(const sync::Member& message, sync::Release why) {
+  ++inputs_[message.input].counters.released[static_cast<size_t>(why)];
+  held_[message.token].text.clear();
+  free_.push_back(static_cast<uint32_t>(message.token));
+}
+
+void SyncedPipeline::check_health(double now) {
+  if (sync_.dead_after <= 0) return;
+  double newest = 0;
+  for (const Input& in : inputs_) newest = std::max(newest, in.counters.last_arrival);
+  if (now - newest > sync_.dead_after) return;  // everything is quiet, not one input
+  for (Input& in : inputs_) {
+    const double silent = in.counters.received ? now - in.counters.last_arrival : -1;
+    if (in.counters.reported_dead || (in.counters.received && silent <= sync_.dead_after)) continue;
+    if (!in.counters.received && now - first_arrival_ <= sync_.dead_after) continue;
+    in.counters.reported_dead = true;
+    std::string what = sync_.policy == sync::PolicyKind::Merge
+                           ? "its fields hold their last values"
+                           : std::string("no ") + sync::to_string(sync_.policy) + " set can form without it";
+    std::fprintf(stderr, "rvc: warning: input '%s' (%s): %s while the others deliver: %s\n", in.spec.name.c_str(),
+                 in.spec.uri.c_str(),
+                 in.counters.received ? ("no message for " + std::to_string(static_cast<int>(silent)) + " s").c_str()
+                                      : "nothing received yet",
+                 what.c_str());
+  }
+}
+
+void SyncedPipeline::idle() {
+  const double now = wall_now();
+  check_health(now);
+  // Stamps that follow the clock (arrival stamps, live ROS stamps): the
+  // merge watermark moves on while nothing comes, so the last messages are
+  // checked without waiting for the next one.
+  bool clocked = true;
+  for (const Input& in : inputs_) clocked = clocked && in.arrival_stamp;
+  if (clocked) policy_->advance(now);
+}
+
+void SyncedPipeline::end_of_input() {
+  if (ended_) return;
+  ended_ = true;
+  policy_->finish();
+}
+
+void SyncedPipeline::warn(const io::LineError& warning) { inputs_[0].pipeline->warn(warning); }
+
+void SyncedPipeline::finish_report() {
+  for (auto& in : inputs_) in.pipeline->finish_report();
+  if (reported_ > options_.max_reported)
+    std::fprintf(stderr, "rvc: %llu more errors were not shown\n",
+                 static_cast<unsigned long long>(reported_ - options_.max_reported));
+}
+
+const PipelineStats& SyncedPipeline::stats() const {
+  stats_ = PipelineStats{sets_, sets_rejected_, 0};
+  for (const Input& in : inputs_) {
+    stats_.rejected += in.pipeline->stats().rejected;
+    stats_.warnings += in.pipeline->stats().warnings;
+  }
+  return stats_;
+}
+
+void SyncedPipeline::add_stats(io::JsonObject& out) const {
+  io::JsonArray per_input;
+  const double now = wall_now();
+  for (const Input& in : inputs_) {
+    const InputCounters& c = in.counters;
+    io::JsonObject dropped;
+    for (size_t r = 0; r < sync::kReleaseKinds; ++r)
+      if (r != static_cast<size_t>(sync::Release::Used) && c.released[r])
+        dropped.add(sync::to_string(static_cast<sync::Release>(r)), c.released[r]);
+    io::JsonObject o;
+    o.add("name", in.spec.name)
+        .add("uri", in.spec.uri)
+        .add("received", c.received)
+        .add("rejected", in.pipeline->stats().rejected)
+        .add("used", c.used)
+        .add("dropped", dropped);
+    if (c.received) o.add_fixed("silent_s", now - c.last_arrival, 3);
+    per_input.add(o);
+  }
+  out.add_raw("sync", io::JsonObject()
+                          .add("policy", sync::to_string(sync_.policy))
+                          .add("sets", sets_)
+                          .add("sets_rejected", sets_rejected_)
+                          .add("held", policy_->held())
+                          .add_raw("inputs", per_input.str())
+                          .str());
+}
+
+}  // namespace rvc::runtime
