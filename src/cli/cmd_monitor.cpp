@@ -38,6 +38,7 @@ struct MonitorCommand {
   std::vector<std::string> outputs;
   std::string stats_output;
   std::string sets_output;             // several inputs: also publish the sets checked
+  std::string verdict_type;            // --verdict-type: typed verdicts on dds:/zenoh: outputs
   bool exit_on_eos = false;
   size_t publishers = 1;  // --publishers: end-of-stream markers to wait for
   double idle_timeout = 0;
@@ -102,10 +103,35 @@ struct MonitorCommand {
   }
 
   int open_outputs(std::vector<std::unique_ptr<transport::Sink>>& sinks, std::unique_ptr<transport::Sink>& stats_sink) {
-    if (int status = cli::open_outputs(outputs, transports, wait_subscribers, wait_timeout, "monitor", sinks))
+    transport::TransportOptions verdict_transports = transports;
+#ifdef RVC_HAVE_DDS
+    verdict_transports.dds.ros_type = verdict_msg_type();
+#endif
+    if (int status = cli::open_outputs(outputs, verdict_transports, wait_subscribers, wait_timeout, "monitor", sinks))
       return status;
     if (!stats_output.empty()) stats_sink = transport::open_sink(stats_output, transports);
     return 0;
+  }
+
+  // The verdicts' ROS 2 type (null: std_msgs/String JSON); resolved once.
+  const msg::MessageType* verdict_msg_type() {
+    if (verdict_type.empty()) return nullptr;
+    if (!verdict_msg_) {
+      for (const auto& p : typed.msg_paths) typed.registry.add_search_path(p);
+      verdict_msg_ = &typed.registry.resolve(verdict_type);
+    }
+    return verdict_msg_;
+  }
+  const msg::MessageType* verdict_msg_ = nullptr;
+
+  runtime::VerdictOutputs make_verdicts(std::vector<std::unique_ptr<transport::Sink>> sinks) {
+    runtime::VerdictOutputs verdicts(std::move(sinks), !check.dense);
+    if (verdict_msg_type()) {
+      std::vector<bool> typed_sinks;
+      for (const auto& uri : outputs) typed_sinks.push_back(TypeOptions::typed_scheme(uri));
+      verdicts.set_typed(verdict_msg_type(), typed_sinks);
+    }
+    return verdicts;
   }
 
   // Several named inputs: synchronized into one stream in this process.
@@ -137,7 +163,7 @@ struct MonitorCommand {
     std::unique_ptr<transport::Sink> stats_sink;
     std::vector<std::unique_ptr<transport::Sink>> sinks;
     if (int status = open_outputs(sinks, stats_sink)) return status;
-    runtime::VerdictOutputs verdicts(std::move(sinks), !check.dense);
+    runtime::VerdictOutputs verdicts = make_verdicts(std::move(sinks));
     runtime::PipelineOptions popts = check.pipeline_options();
     popts.position_name = files ? "line" : "seq";
     // --sets-output: what the properties saw, for `rvc check` to replay.
@@ -207,7 +233,7 @@ struct MonitorCommand {
     std::unique_ptr<transport::Sink> stats_sink;
     std::vector<std::unique_ptr<transport::Sink>> sinks;
     if (int status = open_outputs(sinks, stats_sink)) return status;
-    runtime::VerdictOutputs verdicts(std::move(sinks), !check.dense);
+    runtime::VerdictOutputs verdicts = make_verdicts(std::move(sinks));
     runtime::PipelineOptions popts = check.pipeline_options();
     popts.position_name = "seq";
     if (transport::scheme_of(input) == "mcap") return run_bag(properties, popts, verdicts);
@@ -262,6 +288,9 @@ Runner register_monitor(CLI::App& app) {
       ->check(CLI::NonNegativeNumber);
   sub->add_option("--stats-interval", cmd->stats_interval, "Print counters every S seconds (also on SIGUSR1)");
   sub->add_option("--stats-output", cmd->stats_output, "Also publish the counters (JSON) to this endpoint");
+  sub->add_option("--verdict-type", cmd->verdict_type,
+                  "Publish verdicts on dds:/zenoh: outputs as this ROS 2 type (rvc_msgs/msg/Verdict: time, property, "
+                  "value) instead of std_msgs/String JSON; files still get JSON lines");
   sub->add_option("--sets-output", cmd->sets_output,
                   "Several inputs: also publish each synchronized set (JSON, as rvc sync) to this endpoint");
   sub->add_option("--wait-subscribers", cmd->wait_subscribers,

@@ -1,5 +1,8 @@
 #include "runtime/verdict_outputs.hpp"
 
+#include <stdexcept>
+
+#include "io/cdr_codec.hpp"
 #include "io/verdict_writer.hpp"
 
 namespace rvc::runtime {
@@ -9,7 +12,12 @@ void VerdictOutputs::put(const engine::Verdict& v) {
   io::append_verdict(line_, v.time, discrete_, v.property, v.value);
   line_.pop_back();  // one message per verdict: no newline (file sinks add their own)
   ++count_;
-  for (auto& s : sinks_) s->put(line_, count_);
+  if (type_) {
+    std::string error;
+    if (!io::json_to_cdr(*type_, line_, sample_, error))
+      throw std::runtime_error("verdict as " + type_->full_name() + ": " + error);
+  }
+  for (size_t i = 0; i < sinks_.size(); ++i) sinks_[i]->put(type_ && typed_[i] ? sample_ : line_, count_);
 }
 
 void VerdictOutputs::put_payload(std::string_view payload) {

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "engine/checker.hpp"
+#include "msg/msg_types.hpp"
 #include "transport/endpoint.hpp"
 
 namespace rvc::runtime {
@@ -18,6 +19,13 @@ class VerdictOutputs {
  public:
   VerdictOutputs(std::vector<std::unique_ptr<transport::Sink>> sinks, bool discrete)
       : sinks_(std::move(sinks)), discrete_(discrete) {}
+  // Typed verdicts (`--verdict-type rvc_msgs/msg/Verdict`): sinks whose flag
+  // is set get each verdict as a CDR sample of `type` (encoded from the
+  // verdict's JSON: its fields are time, property, value); the others JSON.
+  void set_typed(const msg::MessageType* type, std::vector<bool> typed_sinks) {
+    type_ = type;
+    typed_ = std::move(typed_sinks);
+  }
 
   // Publishes one verdict on every sink. Throws (std::runtime_error) if a
   // sink cannot take it: verdicts that cannot be delivered end the run.
@@ -37,7 +45,9 @@ class VerdictOutputs {
   std::vector<std::unique_ptr<transport::Sink>> sinks_;
   bool discrete_;
   uint64_t count_ = 0;
-  std::string line_;
+  std::string line_, sample_;
+  const msg::MessageType* type_ = nullptr;
+  std::vector<bool> typed_;
 };
 
 }  // namespace rvc::runtime

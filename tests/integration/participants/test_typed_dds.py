@@ -99,8 +99,14 @@ def types(rvc, tmp_path, monkeypatch):
         stamp: Time_
         report: uint8
 
+    @dataclass
+    class Verdict_(IdlStruct, typename="rvc_msgs::msg::dds_::Verdict_"):
+        time: float64
+        property: str
+        value: bool
+
     return {"Time": Time_, "Deep": Deep_, "Inner": Inner_, "Nothing": Nothing_, "Mixed": Mixed_,
-            "Gear": GearReport_}
+            "Gear": GearReport_, "Verdict": Verdict_}
 
 
 def xcdr1_qos():
@@ -231,6 +237,45 @@ def test_typed_replay_reaches_a_python_subscriber(rvc, tmp_path, types):
     time.sleep(0.3)
     got.extend(reader.take(N=100))
     assert [from_idl(s) for s in got] == values
+
+
+def test_typed_verdicts_reach_a_python_subscriber(rvc, tmp_path, types):
+    """--verdict-type rvc_msgs/msg/Verdict: verdicts on a dds: output are typed samples a Python
+    CycloneDDS reader of its own IDL type reads; a file output keeps JSON lines; the two agree."""
+    from cyclonedds.domain import DomainParticipant
+    from cyclonedds.sub import DataReader
+    from cyclonedds.topic import Topic
+    domain = 100 + os.getpid() % 30
+    trace = tmp_path / "gear.jsonl"
+    trace.write_text("".join(json.dumps({"stamp": {"sec": i, "nanosec": 0}, "report": r}) + "\n"
+                             for i, r in enumerate([2, 22, 20, 2, 20, 22, 20])))
+    dp = DomainParticipant(domain)
+    reader = DataReader(dp, Topic(dp, "rt/rv/typed_verdicts", types["Verdict"]), qos=xcdr1_qos())
+    out = tmp_path / "verdicts.jsonl"
+    mon = subprocess.Popen([rvc, "monitor", "--all", "--spec", "{report == REVERSE} -> pre {report == PARK}",
+                            "--input", "dds:/vehicle/status/gear_status", "--type", GEAR, "--output",
+                            "dds:/rv/typed_verdicts", "--output", f"file:{out}", "--verdict-type",
+                            "rvc_msgs/msg/Verdict", "--wait-subscribers", "1", "--domain", str(domain),
+                            "--idle-timeout", "3"], stderr=subprocess.PIPE, text=True)
+    try:
+        rep = subprocess.run([rvc, "replay", str(trace), "--to", "dds:/vehicle/status/gear_status", "--type", GEAR,
+                              "--domain", str(domain), "--no-progress"], capture_output=True, text=True,
+                             timeout=HANG_GUARD)
+        assert rep.returncode == 0, rep.stderr
+        _, err = mon.communicate(timeout=HANG_GUARD)
+        assert mon.returncode == 1, err  # the spec is violated at step 4
+    finally:
+        if mon.poll() is None:
+            mon.kill()
+    expected = [json.loads(line) for line in out.read_text().splitlines()]
+    assert len(expected) == 7 and not all(v["value"] for v in expected)
+    got = []
+
+    def collect():
+        got.extend(reader.take(N=100))
+        return len(got) >= len(expected)
+    wait_for(collect, "the typed verdicts")
+    assert [{"time": v.time, "property": v.property, "value": v.value} for v in got] == expected
 
 
 def test_typed_replay_to_monitor_with_constants(rvc, tmp_path, types):
