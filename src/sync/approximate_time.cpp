@@ -67,7 +67,9 @@ ApproximateTime::ApproximateTime(const PolicyOptions& options, Handler& handler)
 
 bool ApproximateTime::better(uint32_t a, uint32_t b, bool latest) const {
   if (keys_[a] != keys_[b]) return latest ? keys_[a] > keys_[b] : keys_[a] < keys_[b];
-  return latest ? a > b : a < b;  // message_filters' scan order: the earliest head is the lowest input, the latest the highest
+  // message_filters scans the inputs in order and replaces its earliest head
+  // only on a strictly earlier one, its latest head on an equal or later one.
+  return latest ? a > b : a < b;
 }
 
 double ApproximateTime::key_of(uint32_t input) const {
@@ -144,14 +146,20 @@ void ApproximateTime::make_candidate() {
   with_past_.clear();
 }
 
+// Puts every past message back at the front of its queue and drops the
+// candidate. Only inputs with a past change (an input whose queue is empty
+// while a candidate exists holds the candidate's member in its past), so this
+// is not O(N): an input that keeps overflowing stays cheap.
 void ApproximateTime::recover_all() {
+  has_pivot_ = false;
   for (uint32_t i : with_past_) {
-    rings_[i].past = 0;
+    Ring& r = rings_[i];
+    if (r.past > 0 && r.queued() == 0) ++non_empty_;
+    r.past = 0;
     in_with_past_[i] = 0;
+    update_key(i);
   }
   with_past_.clear();
-  non_empty_ = 0;
-  for (const Ring& r : rings_) non_empty_ += r.queued() > 0;
 }
 
 void ApproximateTime::publish() {
@@ -195,16 +203,15 @@ void ApproximateTime::add(const Member& message) {
   }
   // process() may leave queue_size + 1 messages in this input; past ones count.
   if (r.size > queue_size_) {
+    const bool had_candidate = has_pivot_;
     recover_all();  // the candidate search is void: start over with the oldest of this input gone
-    Slot s = r.pop_front();
+    Slot s = r.pop_front();  // more than queue_size >= 1 messages: the queue stays non-empty
     --held_;
+    update_key(i);
     if (!dropped_[i]) {
       dropped_[i] = 1;
       dropped_list_.push_back(i);
     }
-    bool had_candidate = has_pivot_;
-    has_pivot_ = false;
-    rebuild_keys();
     release(i, s, Release::Overflow);
     if (had_candidate) process();  // the remaining messages may still make one
   }

@@ -11,9 +11,9 @@
 // same inputs give the same sets.
 //
 // Differences from message_filters: any N (no limit of 9); a message stamped
-// earlier than its input's previous message is released as Late at once
-// (message_filters only warns and then misbehaves); every message leaves
-// through Handler::on_release with the reason.
+// earlier than its input's previous message (or not a finite number) is
+// released as Late at once (message_filters only warns, and its sets may then
+// cross); every message leaves through Handler::on_release with the reason.
 //
 // Data layout: per input one ring buffer holds the "past" messages followed by
 // the queue proper, so moving the queue's head to the past, and recovering

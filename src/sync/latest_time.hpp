@@ -9,8 +9,10 @@
 // mean interval between its own stamps, (newest - oldest stamp) / (messages - 1),
 // ties to the lower input. An input needs two messages to have a rate; until
 // some input has one, the pivot is the input with the most messages (ties:
-// the lower input), so a set can go out on the very first round. The pivot is
-// chosen after the arriving message has updated its input's rate.
+// the lower input). Since a set needs every input to hold a message, that
+// means input 0 in effect, and a set can go out on the very first round
+// (message_filters waits for rates). The pivot is chosen after the arriving
+// message has updated its input's rate.
 //
 // A held message replaced by a newer one of its input is released Used if a
 // set included it, else Replaced. Stamps need not increase (arrival order
