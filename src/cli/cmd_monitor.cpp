@@ -180,20 +180,14 @@ struct MonitorCommand {
                                      [&](const engine::Verdict& v) { verdicts.put(v); }, on_set);
     runtime::LoopOptions lopts = loop_options(files != 0);
     lopts.input_names = names;
-    lopts.input.clear();
-    for (const auto& n : names) lopts.input += (lopts.input.empty() ? "" : ",") + n;
+    lopts.input = SyncFlags::joined_names(named);
     runtime::MonitorLoop loop(pipeline, verdicts, stats_sink.get(), lopts);
-    std::vector<std::unique_ptr<transport::Source>> sources;
-    std::vector<transport::Source*> raw;
-    for (size_t i = 0; i < named.size(); ++i) {
-      sources.push_back(transport::open_source(named[i].uri, per_input[i]));
-      raw.push_back(sources.back().get());
-    }
+    SyncFlags::Sources sources = SyncFlags::open_sources(named, per_input);
     install_stop_signals();
     std::fprintf(stderr, "rvc monitor: %zu propert%s on %zu inputs (%s, sync %s) -> %zu output%s\n",
                  properties.size(), properties.size() == 1 ? "y" : "ies", named.size(), lopts.input.c_str(),
                  sync.policy.c_str(), verdicts.size(), verdicts.size() == 1 ? "" : "s");
-    runtime::Outcome outcome = loop.run(raw);
+    runtime::Outcome outcome = loop.run(sources.list);
     try {
       sets.finish();
     } catch (const std::exception& e) {

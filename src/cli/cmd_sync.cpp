@@ -73,7 +73,7 @@ struct SyncCommand {
                                      [&](std::string_view json, double) { sets.put_payload(json); });
 
     runtime::LoopOptions lopts;
-    for (const auto& n : names) lopts.input += (lopts.input.empty() ? "" : ",") + n;
+    lopts.input = SyncFlags::joined_names(named);
     lopts.input_names = names;
     lopts.exit_on_eos = exit_on_eos || files;
     lopts.publishers = publishers;
@@ -83,16 +83,11 @@ struct SyncCommand {
     lopts.stop_requested = stop_requested;
     lopts.stats_requested = stats_requested;
     runtime::MonitorLoop loop(pipeline, sets, stats_sink.get(), lopts);
-    std::vector<std::unique_ptr<transport::Source>> sources;
-    std::vector<transport::Source*> raw;
-    for (size_t i = 0; i < named.size(); ++i) {
-      sources.push_back(transport::open_source(named[i].uri, per_input[i]));
-      raw.push_back(sources.back().get());
-    }
+    SyncFlags::Sources sources = SyncFlags::open_sources(named, per_input);
     install_stop_signals();
     std::fprintf(stderr, "rvc sync: %zu inputs (%s), %s -> %zu output%s\n", named.size(), lopts.input.c_str(),
                  sync.policy.c_str(), sets.size(), sets.size() == 1 ? "" : "s");
-    const runtime::Outcome outcome = loop.run(raw);
+    const runtime::Outcome outcome = loop.run(sources.list);
     return outcome.exit_code();
   }
 };

@@ -129,6 +129,22 @@ void SyncFlags::apply_stamps(std::vector<runtime::SyncInput>& inputs) const {
   }
 }
 
+SyncFlags::Sources SyncFlags::open_sources(const std::vector<runtime::SyncInput>& inputs,
+                                           const std::vector<transport::TransportOptions>& per_input) {
+  Sources s;
+  for (size_t i = 0; i < inputs.size(); ++i) {
+    s.owned.push_back(transport::open_source(inputs[i].uri, per_input[i]));
+    s.list.push_back(s.owned.back().get());
+  }
+  return s;
+}
+
+std::string SyncFlags::joined_names(const std::vector<runtime::SyncInput>& inputs) {
+  std::string s;
+  for (const auto& in : inputs) s += (s.empty() ? "" : ",") + in.name;
+  return s;
+}
+
 runtime::SyncOptions SyncFlags::options(const std::vector<runtime::SyncInput>& inputs) const {
   runtime::SyncOptions o;
   o.policy = sync::policy_from_string(policy);

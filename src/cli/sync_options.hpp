@@ -9,11 +9,13 @@
 
 #include <CLI/CLI.hpp>
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "cli/type_options.hpp"
 #include "runtime/synced_pipeline.hpp"
+#include "transport/endpoint.hpp"
 #include "transport/transport_options.hpp"
 
 namespace rvc::cli {
@@ -45,6 +47,16 @@ struct SyncFlags {
                                           const transport::TransportOptions& transports,
                                           std::vector<transport::TransportOptions>& per_input) const;
   runtime::SyncOptions options(const std::vector<runtime::SyncInput>& inputs) const;
+
+  // The inputs' sources, opened in order (input i = sources[i]), and their
+  // names joined for the counters ("gear,steer").
+  struct Sources {
+    std::vector<std::unique_ptr<transport::Source>> owned;
+    std::vector<transport::Source*> list;
+  };
+  static Sources open_sources(const std::vector<runtime::SyncInput>& inputs,
+                              const std::vector<transport::TransportOptions>& per_input);
+  static std::string joined_names(const std::vector<runtime::SyncInput>& inputs);
   // --stamp NAME=PATH onto the inputs; throws std::invalid_argument for an unknown NAME.
   void apply_stamps(std::vector<runtime::SyncInput>& inputs) const;
 };
