@@ -4,6 +4,9 @@
 // on every output, which `rvc monitor` (or `rvc check` on a file) then reads
 // as one stream with properties over {gear.report}, {steer.…}.
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
 #include <memory>
 #include <string>
 #include <vector>
@@ -38,6 +41,29 @@ struct SyncCommand {
   double stats_interval = 0;
   size_t wait_subscribers = 0;
   double wait_timeout = 10;
+  std::string set_type;      // --set-type: publish sets typed, as this message of the inputs' types
+  std::string set_type_dir;  // --set-type-dir: where its .msg definition is written for subscribers
+
+  // The set as a ROS 2 message: float64 time, then each input's message
+  // under its name. Registered (and written to --set-type-dir) so the sets
+  // can be published typed; every input must be typed.
+  const msg::MessageType* define_set_type(const std::vector<runtime::SyncInput>& named) {
+    std::string text = "# Written by rvc sync: one synchronized set (time = the set's stamp, seconds).\nfloat64 time\n";
+    for (const auto& in : named) {
+      if (!in.type)
+        throw std::invalid_argument("--set-type: input '" + in.name + "' carries JSON; typed sets need every input typed");
+      text += in.type->package + "/" + in.type->name + " " + in.name + "\n";
+    }
+    typed.registry.add_definition(set_type, text, "rvc sync --set-type");
+    const msg::MessageType* t = &typed.registry.resolve(set_type);
+    if (!set_type_dir.empty()) {
+      const std::filesystem::path dir = std::filesystem::path(set_type_dir) / t->package / "msg";
+      std::filesystem::create_directories(dir);
+      std::ofstream(dir / (t->name + ".msg")) << text;
+    }
+    std::fprintf(stderr, "rvc sync: sets are %s:\n%s", t->full_name().c_str(), text.c_str());
+    return t;
+  }
 
   int run() {
     if (outputs.empty()) outputs.push_back("-");
@@ -58,11 +84,22 @@ struct SyncCommand {
       std::fprintf(stderr, "rvc: inputs are all files or all topics, not a mix\n");
       return kUsage;
     }
+    const msg::MessageType* typed_sets = set_type.empty() ? nullptr : define_set_type(named);
+    transport::TransportOptions out_transports = transports;
+#ifdef RVC_HAVE_DDS
+    out_transports.dds.ros_type = typed_sets;
+#endif
     std::vector<std::unique_ptr<transport::Sink>> sinks;
-    if (int status = open_outputs(outputs, transports, wait_subscribers, wait_timeout, "sync", sinks)) return status;
+    if (int status = open_outputs(outputs, out_transports, wait_subscribers, wait_timeout, "sync", sinks))
+      return status;
     std::unique_ptr<transport::Sink> stats_sink;
     if (!stats_output.empty()) stats_sink = transport::open_sink(stats_output, transports);
     runtime::VerdictOutputs sets(std::move(sinks), true);
+    if (typed_sets) {
+      std::vector<bool> typed_sinks;
+      for (const auto& uri : outputs) typed_sinks.push_back(TypeOptions::typed_scheme(uri));
+      sets.set_typed(typed_sets, typed_sinks);
+    }
 
     runtime::PipelineOptions popts;
     popts.parse_only = true;  // no properties: sets only
@@ -107,6 +144,11 @@ Runner register_sync(CLI::App& app) {
       ->allow_extra_args(false);
   cmd->typed.add_to(*sub, "ROS 2 type of the --input before it (or NAME=pkg/msg/Name)");
   cmd->sync.add_to(*sub);
+  sub->add_option("--set-type", cmd->set_type,
+                  "Publish sets on dds:/zenoh: outputs typed, as this message (e.g. rvc_sync/msg/Set): float64 time "
+                  "plus each input's message under its name; needs every input typed");
+  sub->add_option("--set-type-dir", cmd->set_type_dir,
+                  "Write the --set-type definition here (DIR/pkg/msg/Name.msg) for subscribers' --msg-path");
   sub->add_option("--time-field", cmd->time_field, "JSON inputs: the field holding the stamp (seconds)")
       ->capture_default_str();
   sub->add_option("--max-message-size", cmd->max_message_size, "Longest accepted message in bytes")

@@ -22,7 +22,12 @@ void VerdictOutputs::put(const engine::Verdict& v) {
 
 void VerdictOutputs::put_payload(std::string_view payload) {
   ++count_;
-  for (auto& s : sinks_) s->put(payload, count_);
+  if (type_) {
+    std::string error;
+    if (!io::json_to_cdr(*type_, payload, sample_, error))
+      throw std::runtime_error("set as " + type_->full_name() + ": " + error);
+  }
+  for (size_t i = 0; i < sinks_.size(); ++i) sinks_[i]->put(type_ && typed_[i] ? sample_ : payload, count_);
 }
 
 void VerdictOutputs::idle() {

@@ -30,7 +30,8 @@ class VerdictOutputs {
   // Publishes one verdict on every sink. Throws (std::runtime_error) if a
   // sink cannot take it: verdicts that cannot be delivered end the run.
   void put(const engine::Verdict& verdict);
-  // Publishes one ready payload the same way (`rvc sync`: one set as JSON).
+  // Publishes one ready JSON payload the same way (`rvc sync`: one set), as
+  // a sample of the typed type on typed sinks.
   void put_payload(std::string_view payload);
   // Nothing pending upstream: make buffered verdicts visible.
   void idle();

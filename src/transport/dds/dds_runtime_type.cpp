@@ -120,8 +120,10 @@ class OpsBuilder {
     order(top);
     for (const MessageType* m : queue_) emit_block(*m);
     for (const auto& p : patches_) {
-      const uint32_t jump = static_cast<uint32_t>(start_.at(p.target) - p.insn);
-      ops_[p.word] = (p.insn_len << 16) + jump;
+      // A signed 16-bit jump: a nested type already emitted for an earlier
+      // field (Time inside two different messages) lies behind the caller.
+      const auto jump = static_cast<int64_t>(start_.at(p.target)) - static_cast<int64_t>(p.insn);
+      ops_[p.word] = (p.insn_len << 16) | (static_cast<uint32_t>(jump) & 0xffffu);
     }
     return ops_;
   }

@@ -58,6 +58,8 @@ TEST(DdsRuntimeType, SameDescriptorAsIdlc) {
   expect_same("rvc_test_msgs/msg/Inner", rvc_test_msgs_msg_dds__Inner__desc);
   expect_same("rvc_test_msgs/msg/Nothing", rvc_test_msgs_msg_dds__Nothing__desc);
   expect_same("rvc_test_msgs/msg/Mixed", rvc_test_msgs_msg_dds__Mixed__desc);
+  // Deep is reached through Inner before Wrap refers to it: a backward jump.
+  expect_same("rvc_test_msgs/msg/Pair", rvc_test_msgs_msg_dds__Pair__desc);
 }
 
 TEST(DdsRuntimeType, TypeNameIsTheRos2DdsName) {

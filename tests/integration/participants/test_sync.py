@@ -18,6 +18,7 @@ import json
 import os
 import random
 import subprocess
+import time
 
 import pytest
 
@@ -229,3 +230,52 @@ def test_named_inputs_are_checked_before_anything_runs(rvc, tmp_path):
     assert r.returncode == 2 and "synchronize several inputs" in r.stderr, r.stderr
     r = subprocess.run(base + ["--input", "c=file:x.jsonl", "--spec", "{a.x}"], capture_output=True, text=True)
     assert r.returncode == 2 and "not a mix" in r.stderr, r.stderr
+
+
+def test_typed_sets_are_read_by_a_typed_monitor(rvc, tmp_path, dds):
+    """rvc sync --set-type: the sets published as a ROS 2 message of the inputs' types (its .msg
+    written for subscribers); `rvc monitor --type` on that topic gives the verdicts `rvc check`
+    gives on the same sync's JSON sets."""
+    domain = 70 + os.getpid() % 30
+    dds_flags = ["--domain", str(domain)]
+    traces, _ = make_traces(tmp_path)
+    chosen = [t for t in TOPICS if t[0] in ("gear", "steer")]
+    sets_json, verdicts, defs = tmp_path / "sets.jsonl", tmp_path / "verdicts.jsonl", tmp_path / "defs"
+    inputs = [a for name, topic, type_name, *_ in chosen for a in ("--input", f"{name}=dds:{topic}", "--type",
+                                                                     type_name)]
+    # Replays at full speed deliver whole topics at once: a queue that holds them all.
+    sync = subprocess.Popen([rvc, "sync", *inputs, "--sync", "approximate", "--sync-queue", "200", "--set-type",
+                             "rvc_sync/msg/Set",
+                             "--set-type-dir", str(defs), "--output", "dds:/rv/synced", "--output",
+                             f"file:{sets_json}", "--wait-subscribers", "1", "--idle-timeout", "5", *dds_flags],
+                            stderr=subprocess.PIPE, text=True)
+    # The definition is written before the outputs wait for their subscriber.
+    deadline = HANG_GUARD
+    while not (defs / "rvc_sync" / "msg" / "Set.msg").exists() and deadline > 0:
+        time.sleep(0.1)
+        deadline -= 0.1
+    spec = "{gear.report == REVERSE} -> {steer.steering_tire_angle < 0.3}"
+    mon = subprocess.Popen([rvc, "monitor", "--all", "--spec", spec, "--input", "dds:/rv/synced", "--type",
+                            "rvc_sync/msg/Set", "--msg-path", str(defs), "--output", f"file:{verdicts}",
+                            "--idle-timeout", "8", *dds_flags], stderr=subprocess.PIPE, text=True)
+    try:
+        replays = [subprocess.Popen([rvc, "replay", str(traces[name]), "--to", f"dds:{topic}", "--type", type_name,
+                                     "--wait-timeout", "30", "--no-progress", *dds_flags],
+                                    stderr=subprocess.PIPE, text=True) for name, topic, type_name, *_ in chosen]
+        for p in replays:
+            _, err = p.communicate(timeout=HANG_GUARD)
+            assert p.returncode == 0, err
+        _, sync_err = sync.communicate(timeout=HANG_GUARD)
+        _, mon_err = mon.communicate(timeout=HANG_GUARD)
+    finally:
+        for p in (sync, mon):
+            if p.poll() is None:
+                p.kill()
+    assert sync.returncode == 0, sync_err
+    assert "float64 time" in (defs / "rvc_sync" / "msg" / "Set.msg").read_text()
+    sets = read_jsonl(sets_json)
+    assert len(sets) >= SECONDS * 25 - 2, sync_err
+    check = subprocess.run([rvc, "check", "--all", "--spec", "{gear.report == 20} -> {steer.steering_tire_angle < 0.3}",
+                            str(sets_json)], capture_output=True, text=True)
+    assert read_jsonl(verdicts) == [json.loads(l) for l in check.stdout.splitlines()], mon_err
+    assert any(not json.loads(l)["value"] for l in check.stdout.splitlines()), "no violation: a weak test"
