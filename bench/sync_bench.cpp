@@ -10,15 +10,22 @@
 // overflows its queue (the policy's worst steady state). The handler counts
 // sets and releases. Each case runs in its own forked process so that its RSS
 // is its own.
+// Latency added per set (a third, untimed pass): in the stream's own time, how
+// long after its newest member arrived a set came out, where a message
+// arrives at the newest stamp seen so far (round robin, no transport delay):
+// what the policy itself adds, waiting for the messages that decide a set.
 // Not a test: prints a markdown table, asserts nothing about time.
 //   build/release/rvc_sync_bench
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <memory>
+#include <string>
+#include <vector>
 
 #include "sync/policy.hpp"
 
@@ -34,6 +41,18 @@ struct Counter : Handler {
   size_t sets = 0, releases = 0;
   void on_set(const Member*, size_t, double) override { ++sets; }
   void on_release(const Member&, Release) override { ++releases; }
+};
+
+// Records, per set, now - the newest member's stamp.
+struct Waits : Handler {
+  double now = 0;
+  std::vector<double> waits;
+  void on_set(const Member* m, size_t n, double) override {
+    double newest = m[0].stamp;
+    for (size_t i = 1; i < n; ++i) newest = std::max(newest, m[i].stamp);
+    waits.push_back(now - newest);
+  }
+  void on_release(const Member&, Release) override {}
 };
 
 // Stamp of message k: deterministic, cheap (a few ns), per-input increasing.
@@ -56,6 +75,25 @@ void feed(Policy& policy, size_t inputs, bool jitter, bool silent, size_t* max_h
   policy.finish();
 }
 
+// p50 / p99 / max of the waits, in ms (sets emitted by finish() left out).
+std::string wait_percentiles(PolicyKind kind, const PolicyOptions& o, size_t inputs, bool jitter, bool silent) {
+  Waits w;
+  auto policy = make_policy(kind, o, w);
+  for (size_t k = 0; k < kMessages; ++k) {
+    const auto input = static_cast<uint32_t>(k % inputs);
+    if (silent && k >= 1000 && input == inputs - 1) continue;
+    const double stamp = stamp_of(k, inputs, jitter);
+    w.now = std::max(w.now, stamp);
+    policy->add(Member{input, stamp, k});
+  }
+  if (w.waits.empty()) return "- | - | -";
+  std::sort(w.waits.begin(), w.waits.end());
+  auto at = [&](double q) { return w.waits[static_cast<size_t>(q * static_cast<double>(w.waits.size() - 1))] * 1e3; };
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.2f | %.2f | %.2f", at(0.5), at(0.99), w.waits.back() * 1e3);
+  return buf;
+}
+
 void run_case(PolicyKind kind, size_t inputs, bool silent) {
   PolicyOptions o;
   o.inputs = inputs;
@@ -76,16 +114,17 @@ void run_case(PolicyKind kind, size_t inputs, bool silent) {
   getrusage(RUSAGE_SELF, &usage);
   char name[32];
   std::snprintf(name, sizeof name, "%s%s", to_string(kind), silent ? ", 1 silent" : "");
-  std::printf("| %-22s | %6zu | %8.1f | %8zu | %8zu | %9ld |\n", name, inputs, ns, counter.sets, max_held,
-              usage.ru_maxrss);
+  const std::string waits = wait_percentiles(kind, o, inputs, jitter, silent);
+  std::printf("| %-22s | %6zu | %8.1f | %8zu | %8zu | %9ld | %s |\n", name, inputs, ns, counter.sets, max_held,
+              usage.ru_maxrss, waits.c_str());
   if (counter.releases != added) std::printf("  (!) %zu releases for %zu messages\n", counter.releases, added);
 }
 
 }  // namespace
 
 int main() {
-  std::printf("| policy                 | inputs | ns/msg   | sets     | max held | RSS (KiB) |\n");
-  std::printf("|------------------------|--------|----------|----------|----------|-----------|\n");
+  std::printf("| policy                 | inputs | ns/msg   | sets     | max held | RSS (KiB) | wait p50 ms | p99 ms | max ms |\n");
+  std::printf("|------------------------|--------|----------|----------|----------|-----------|---:|---:|---:|\n");
   std::fflush(stdout);
   struct Case {
     PolicyKind kind;
