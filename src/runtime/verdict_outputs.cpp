@@ -11,13 +11,7 @@ void VerdictOutputs::put(const engine::Verdict& v) {
   line_.clear();
   io::append_verdict(line_, v.time, discrete_, v.property, v.value);
   line_.pop_back();  // one message per verdict: no newline (file sinks add their own)
-  ++count_;
-  if (type_) {
-    std::string error;
-    if (!io::json_to_cdr(*type_, line_, sample_, error))
-      throw std::runtime_error("verdict as " + type_->full_name() + ": " + error);
-  }
-  for (size_t i = 0; i < sinks_.size(); ++i) sinks_[i]->put(type_ && typed_[i] ? sample_ : line_, count_);
+  put_payload(line_);
 }
 
 void VerdictOutputs::put_payload(std::string_view payload) {
@@ -25,7 +19,7 @@ void VerdictOutputs::put_payload(std::string_view payload) {
   if (type_) {
     std::string error;
     if (!io::json_to_cdr(*type_, payload, sample_, error))
-      throw std::runtime_error("set as " + type_->full_name() + ": " + error);
+      throw std::runtime_error("as " + type_->full_name() + ": " + error + " in " + std::string(payload));
   }
   for (size_t i = 0; i < sinks_.size(); ++i) sinks_[i]->put(type_ && typed_[i] ? sample_ : payload, count_);
 }
