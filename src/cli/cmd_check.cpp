@@ -9,6 +9,7 @@
 
 #include "cli/check_options.hpp"
 #include "cli/commands.hpp"
+#include "cli/sync_options.hpp"
 #include "msg/type_registry.hpp"
 #include "runtime/check_stream.hpp"
 #ifdef RVC_HAVE_MCAP
