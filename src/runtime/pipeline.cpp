@@ -51,10 +51,13 @@ Pipeline::Pipeline(const std::vector<engine::PropertySpec>& properties, const Pi
       decoder_(atoms_, io::DecoderOptions{options.model == engine::TimeModel::Dense, options.time_field,
                                           options.strict}),
       batch_reader_(*this, options.max_message_size) {
-  if (options_.type) {
-    typed_.emplace(atoms_, *options_.type,
-                   io::DecoderOptions{options.model == engine::TimeModel::Dense, options_.time_field, options.strict});
-  }
+  make_typed_decoder();
+}
+
+void Pipeline::make_typed_decoder() {
+  if (!options_.type) return;
+  typed_.emplace(atoms_, *options_.type,
+                 io::DecoderOptions{options_.model == engine::TimeModel::Dense, options_.time_field, options_.strict});
 }
 
 Pipeline::Pipeline(const engine::AtomTable& atoms, const PipelineOptions& options, MessageHook hook)
@@ -65,10 +68,7 @@ Pipeline::Pipeline(const engine::AtomTable& atoms, const PipelineOptions& option
       decoder_(atoms_, io::DecoderOptions{options.model == engine::TimeModel::Dense, options.time_field,
                                           options.strict}),
       batch_reader_(*this, options.max_message_size) {
-  if (options_.type) {
-    typed_.emplace(atoms_, *options_.type,
-                   io::DecoderOptions{options.model == engine::TimeModel::Dense, options_.time_field, options.strict});
-  }
+  make_typed_decoder();
 }
 
 void Pipeline::report(const std::string& text) {

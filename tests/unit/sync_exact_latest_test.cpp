@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "sync/policy.hpp"
+#include "sync_release_recorder.hpp"
 
 namespace rvc::sync {
 namespace {
@@ -25,11 +26,8 @@ struct SetOut {
   bool operator==(const SetOut&) const = default;
 };
 
-struct Recorder : Handler {
+struct Recorder : test::ReleaseRecorder {
   std::vector<SetOut> sets;
-  std::map<uint64_t, std::pair<Release, size_t>> released;  // token -> (why, step)
-  std::vector<int> count;
-  size_t step = 0;
   void on_set(const Member* members, size_t n, double set_stamp) override {
     SetOut s{{}, set_stamp, step};
     for (size_t i = 0; i < n; ++i) {
@@ -39,11 +37,6 @@ struct Recorder : Handler {
       s.tokens.push_back(members[i].token);
     }
     sets.push_back(s);
-  }
-  void on_release(const Member& m, Release why) override {
-    if (count.size() <= m.token) count.resize(m.token + 1);
-    ++count[m.token];
-    released[m.token] = {why, step};
   }
   std::pair<Release, size_t> of(uint64_t token) const {
     auto it = released.find(token);
@@ -65,7 +58,7 @@ Recorder run(PolicyKind kind, const PolicyOptions& o, const std::vector<Arrival>
   rec.step = in.size();
   p->finish();
   EXPECT_EQ(p->held(), 0u);
-  for (size_t k = 0; k < in.size(); ++k) EXPECT_EQ(k < rec.count.size() ? rec.count[k] : 0, 1) << "message " << k;
+  for (size_t k = 0; k < in.size(); ++k) EXPECT_EQ(rec.releases_of(k), 1) << "message " << k;
   return rec;
 }
 Recorder run(PolicyKind kind, const PolicyOptions& o, const std::vector<Arrival>& in) {

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "sync/policy.hpp"
+#include "sync_release_recorder.hpp"
 
 namespace rvc::sync {
 namespace {
@@ -20,11 +21,8 @@ struct SetOut {
   bool operator==(const SetOut&) const = default;
 };
 
-struct Recorder : Handler {
+struct Recorder : test::ReleaseRecorder {
   std::vector<SetOut> sets;
-  std::map<uint64_t, std::pair<Release, size_t>> released;  // token -> (why, step)
-  std::map<uint64_t, int> count;
-  size_t step = 0;
   void on_set(const Member* members, size_t n, double set_stamp) override {
     SetOut s{{}, set_stamp, step};
     for (size_t i = 0; i < n; ++i) {
@@ -32,10 +30,6 @@ struct Recorder : Handler {
       s.members.emplace_back(members[i].input, members[i].token);
     }
     sets.push_back(s);
-  }
-  void on_release(const Member& m, Release why) override {
-    ++count[m.token];
-    released[m.token] = {why, step};
   }
 };
 
