@@ -85,6 +85,7 @@ std::vector<runtime::SyncInput> SyncFlags::resolve(const std::vector<std::string
     if (!split_named(text, in.name, in.uri))
       throw std::invalid_argument("with several inputs each is NAME=URI (properties test {NAME.field}): '" + text +
                                   "'");
+    if (in.uri.empty()) throw std::invalid_argument("--input " + text + ": no URI after '" + in.name + "='");
     out.push_back(std::move(in));
   }
   // Types: each --type applies to the --input before it, or names its input.

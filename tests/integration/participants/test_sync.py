@@ -228,6 +228,8 @@ def test_named_inputs_are_checked_before_anything_runs(rvc, tmp_path):
     r = subprocess.run([rvc, "monitor", "--input", "dds:/a", "--spec", "{x}", "--sync", "approximate"],
                        capture_output=True, text=True)
     assert r.returncode == 2 and "synchronize several inputs" in r.stderr, r.stderr
+    r = subprocess.run(base + ["--input", "c=", "--spec", "{a.x}"], capture_output=True, text=True)
+    assert r.returncode == 2 and "no URI after 'c='" in r.stderr, r.stderr
     r = subprocess.run(base + ["--input", "c=file:x.jsonl", "--spec", "{a.x}"], capture_output=True, text=True)
     assert r.returncode == 2 and "not a mix" in r.stderr, r.stderr
 
