@@ -142,7 +142,7 @@ Runner register_echo(CLI::App& app) {
   auto cmd = std::make_shared<EchoCommand>();
   CLI::App* sub = app.add_subcommand("echo", "Print the messages of an endpoint as JSON lines (typed ROS 2 topics with --type)");
   sub->add_option("input", cmd->input, "Endpoint: dds:TOPIC, zenoh:KEYEXPR, file:PATH")->required();
-  cmd->typed.add_to(*sub, "ROS 2 message type of the samples, pkg/msg/Name (`rvc msg list`)");
+  cmd->typed.add_to(*sub, "Message type of the samples: ROS 2 pkg/msg/Name (`rvc msg list`) or a DDS IDL name from --msg-path");
   sub->add_option("--field", cmd->fields,
                   "Print only this field of each typed sample, e.g. status.twist (repeatable; the rest is still "
                   "checked)");

@@ -292,7 +292,7 @@ Runner register_monitor(CLI::App& app) {
       ->capture_default_str();
   sub->add_option("--wait-timeout", cmd->wait_timeout, "Seconds to wait for them")->capture_default_str();
   cmd->typed.add_to(*sub,
-                    "ROS 2 message type of the input's CDR payloads, pkg/msg/Name (`rvc msg list`, `rvc msg show`); "
+                    "Message type of the input's CDR payloads: ROS 2 pkg/msg/Name (`rvc msg list`, `rvc msg show`) or a DDS IDL name from --msg-path; "
                     "several inputs: after the --input it is for, or NAME=pkg/msg/Name");
   cmd->sync.add_to(*sub);
   sub->add_option("--topic", cmd->topics,

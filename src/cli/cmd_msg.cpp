@@ -173,7 +173,7 @@ Runner register_msg(CLI::App& app) {
   encode->add_flag("--big-endian", cmd->big_endian, "Write big-endian CDR (default: little endian)");
   for (auto* s : {show, decode, encode})
     s->add_option("--msg-path", cmd->msg_paths,
-                  "Folder of .msg definitions: a ROS 2 share/ tree or a plain folder (repeatable)");
+                  "Folder of .msg/.idl definitions (a ROS 2 share/ tree or a plain folder), or one .idl file (repeatable)");
   return [cmd, list, show, decode, encode]() -> int {
     if (list->parsed()) {
       for (const auto& t : msg::TypeRegistry::bundled_types()) std::printf("%s\n", t.c_str());

@@ -5,7 +5,7 @@ namespace rvc::cli {
 void TypeOptions::add_to(CLI::App& app, const std::string& type_help) {
   type_option = app.add_option("--type", type, type_help)->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
   app.add_option("--msg-path", msg_paths,
-                 "Folder of .msg definitions for --type: a ROS 2 share/ tree or a plain folder (repeatable)");
+                 "Folder of .msg/.idl definitions for --type (a ROS 2 share/ tree or a plain folder), or one .idl file (repeatable)");
 }
 
 const msg::MessageType* TypeOptions::resolve(transport::TransportOptions& transports) {

@@ -106,7 +106,7 @@ class Reader {
   bool scalar(const FieldType& t) {
     switch (t.prim) {
       case Prim::Bool: {
-        bool v;
+        bool v = false;
         if (!in_.boolean(v)) return false;
         put(v ? "true" : "false");
         return true;

@@ -139,32 +139,9 @@ class LineParser {
   }
 
   double parse_number(size_t at, Prim prim, std::string_view text) const {
-    std::string s(text);
-    if (prim == Prim::Bool) {
-      if (s == "true" || s == "True" || s == "1") return 1;
-      if (s == "false" || s == "False" || s == "0") return 0;
-      fail(at, "a bool constant is true or false, not '" + s + "'");
-    }
-    char* end = nullptr;
-    errno = 0;
-    double v = std::strtod(s.c_str(), &end);
-    if (s.empty() || end != s.c_str() + s.size() || errno == ERANGE)
-      fail(at, std::string("not a ") + prim_name(prim) + " value: '" + s + "'");
-    if (prim_is_integer(prim) || prim == Prim::Byte || prim == Prim::Char) {
-      if (std::floor(v) != v) fail(at, std::string("not an integer for ") + prim_name(prim) + ": '" + s + "'");
-      double lo = 0, hi = 0;
-      switch (prim) {
-        case Prim::Int8: lo = -128; hi = 127; break;
-        case Prim::UInt8: case Prim::Byte: case Prim::Char: lo = 0; hi = 255; break;
-        case Prim::Int16: lo = -32768; hi = 32767; break;
-        case Prim::UInt16: lo = 0; hi = 65535; break;
-        case Prim::Int32: lo = -2147483648.0; hi = 2147483647.0; break;
-        case Prim::UInt32: lo = 0; hi = 4294967295.0; break;
-        case Prim::Int64: lo = -9223372036854775808.0; hi = 9223372036854775807.0; break;
-        default: lo = 0; hi = 18446744073709551615.0; break;
-      }
-      if (v < lo || v > hi) fail(at, s + " does not fit in " + prim_name(prim));
-    }
+    double v = 0;
+    std::string error;
+    if (!prim_value(prim, text, v, error)) fail(at, error);
     return v;
   }
 

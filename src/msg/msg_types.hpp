@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace rvc::msg {
@@ -21,6 +22,10 @@ size_t prim_size(Prim p);
 const char* prim_name(Prim p);
 bool prim_is_integer(Prim p);
 bool prim_is_float(Prim p);
+// The value of a constant or default of type `prim` written as `text`
+// (numbers, and true/false/True/False/1/0 for bool), range-checked for
+// integers. False with `error` set when it is not one.
+bool prim_value(Prim prim, std::string_view text, double& value, std::string& error);
 
 enum class ArrayKind : uint8_t { None, Fixed, Bounded, Unbounded };
 
@@ -53,11 +58,18 @@ struct Constant {
 
 struct MessageType {
   std::string package, name;     // "geometry_msgs", "Twist"
+  // Types from a plain DDS .idl (not in a module pkg::msg): the scoped IDL
+  // name ("KeyedSeq", "vehicle::Speed"), which is both its DDS type name and
+  // what --type names it by. Empty for ROS 2 types.
+  std::string idl_name;
   std::vector<Field> fields;     // in wire order; empty messages carry one uint8 on the wire
   std::vector<Constant> constants;
+  // DDS key members (IDL @key or #pragma keylist; ROS 2 types have none):
+  // top-level field names, in the order given.
+  std::vector<std::string> keys;
   std::string source;            // where the definition came from (file path, "bundled", "mcap schema")
 
-  std::string full_name() const { return package + "/msg/" + name; }
+  std::string full_name() const { return idl_name.empty() ? package + "/msg/" + name : idl_name; }
   const Constant* constant(const std::string& constant_name) const;
 };
 

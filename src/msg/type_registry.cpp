@@ -6,6 +6,7 @@
 #include <set>
 #include <sstream>
 
+#include "msg/idl_parser.hpp"
 #include "msg/msg_parser.hpp"
 
 namespace rvc::msg {
@@ -35,8 +36,78 @@ TypeRegistry::TypeRegistry() = default;
 
 void TypeRegistry::add_search_path(const std::string& dir) {
   std::error_code ec;
-  if (!std::filesystem::is_directory(dir, ec)) throw MsgError("--msg-path " + dir + ": not a folder");
+  if (std::filesystem::is_regular_file(dir, ec) && std::filesystem::path(dir).extension() == ".idl") {
+    read_idl_file(dir);
+    return;
+  }
+  if (!std::filesystem::is_directory(dir, ec)) throw MsgError("--msg-path " + dir + ": not a folder or an .idl file");
   search_paths_.push_back(dir);
+}
+
+namespace {
+std::string read_file(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  if (!in || (!in.good() && !in.eof())) throw MsgError(p.string() + ": cannot be read");
+  return ss.str();
+}
+}  // namespace
+
+void TypeRegistry::add_idl(std::string_view text, const std::string& source) {
+  for (auto& t : parse_idl(text, source)) {
+    std::string key = t.full_name();
+    idl_.insert_or_assign(key, std::move(t));
+  }
+}
+
+void TypeRegistry::read_idl_file(const std::string& path) {
+  if (!idl_files_read_.insert(path).second) return;
+  add_idl(read_file(path), path);
+}
+
+void TypeRegistry::add_concatenated_idl(std::string_view text, const std::string& source) {
+  // As ros2msg schemas: sections after a line of '=', each headed "IDL: pkg/msg/Name".
+  std::string current, name = "main";
+  auto flush = [&] {
+    if (current.find_first_not_of(" \t\r\n") != std::string::npos) add_idl(current, source + " (" + name + ")");
+    current.clear();
+  };
+  size_t start = 0;
+  while (start <= text.size()) {
+    size_t end = text.find('\n', start);
+    if (end == std::string_view::npos) end = text.size();
+    std::string_view line = text.substr(start, end - start);
+    if (line.size() >= 3 && line.find_first_not_of("=\r") == std::string_view::npos) {
+      flush();
+    } else if (current.find_first_not_of(" \t\r\n") == std::string::npos && line.substr(0, 4) == "IDL:") {
+      name = std::string(line.substr(4));
+      while (!name.empty() && (name.front() == ' ')) name.erase(0, 1);
+    } else {
+      current.append(line).push_back('\n');
+    }
+    start = end + 1;
+  }
+  flush();
+}
+
+void TypeRegistry::scan_idl_files() {
+  if (idl_scanned_) return;
+  idl_scanned_ = true;
+  namespace fs = std::filesystem;
+  for (const auto& dir : search_paths_) {
+    std::error_code ec;
+    for (fs::recursive_directory_iterator it(dir, fs::directory_options::skip_permission_denied, ec), end;
+         !ec && it != end; it.increment(ec)) {
+      if (it.depth() > 4) it.disable_recursion_pending();
+      if (!it->is_regular_file(ec) || it->path().extension() != ".idl") continue;
+      try {
+        read_idl_file(it->path().string());
+      } catch (const MsgError& e) {  // a broken file that may not matter: named if the type is not found
+        idl_scan_errors_ += std::string("\n  skipped ") + e.what();
+      }
+    }
+  }
 }
 
 void TypeRegistry::add_definition(const std::string& type_name, std::string text, const std::string& source) {
@@ -73,76 +144,94 @@ void TypeRegistry::add_concatenated(const std::string& type_name, std::string_vi
   if (!current_type.empty()) flush();
 }
 
-bool TypeRegistry::find_text(const std::string& package, const std::string& name, std::string& text,
-                             std::string& source) const {
+TypeRegistry::Found TypeRegistry::find_definition(const std::string& package, const std::string& name,
+                                                  std::string& text, std::string& source) {
   auto added = added_.find(package + "/msg/" + name);
   if (added != added_.end()) {
     text = added->second.first;
     source = added->second.second;
-    return true;
+    return Found::Msg;
   }
   namespace fs = std::filesystem;
   for (const auto& dir : search_paths_) {
-    for (fs::path p : {fs::path(dir) / package / "msg" / (name + ".msg"),
-                       fs::path(dir) / "share" / package / "msg" / (name + ".msg"),
-                       fs::path(dir) / package / (name + ".msg"), fs::path(dir) / (name + ".msg")}) {
-      std::error_code ec;
-      if (!fs::is_regular_file(p, ec)) continue;
-      std::ifstream in(p, std::ios::binary);
-      std::stringstream ss;
-      ss << in.rdbuf();
-      if (!in.good() && !in.eof()) throw MsgError(p.string() + ": cannot be read");
-      text = ss.str();
-      source = p.string();
-      return true;
+    for (const char* ext : {".msg", ".idl"}) {
+      for (fs::path p : {fs::path(dir) / package / "msg" / (name + ext), fs::path(dir) / "share" / package / "msg" / (name + ext),
+                         fs::path(dir) / package / (name + ext), fs::path(dir) / (name + ext)}) {
+        std::error_code ec;
+        if (!fs::is_regular_file(p, ec)) continue;
+        if (ext[1] == 'm') {
+          text = read_file(p);
+          source = p.string();
+          return Found::Msg;
+        }
+        read_idl_file(p.string());
+        if (idl_.count(package + "/msg/" + name)) return Found::Idl;
+      }
     }
   }
   std::string_view bundled = bundled_definition(package + "/msg/" + name);
   if (bundled.data()) {  // std_msgs/Empty is bundled with an empty text
     text = std::string(bundled);
     source = "bundled " + package + "/msg/" + name + ".msg";
-    return true;
+    return Found::Msg;
   }
-  return false;
+  return Found::None;
 }
 
 const MessageType& TypeRegistry::resolve(std::string_view type_name) {
-  std::string pkg, name;
-  if (!split_type_name(type_name, pkg, name))
-    throw MsgError("not a message type name: '" + std::string(type_name) +
-                   "' (expected pkg/msg/Name, e.g. geometry_msgs/msg/Twist)");
-  return load(pkg, name, 0);
+  const std::string key(type_name);
+  if (known(key)) return load(key, 0);
+  std::string pkg, name, text, source;
+  const bool ros = split_type_name(type_name, pkg, name);
+  // "pkg/msg/Name" is always ROS 2; "a::B" may be a ROS 2 pkg::Name or a plain IDL name.
+  if (ros && (key.find('/') != std::string::npos || key.find("::msg::") != std::string::npos ||
+              known(pkg + "/msg/" + name) || find_definition(pkg, name, text, source) != Found::None))
+    return load(pkg + "/msg/" + name, 0);
+  scan_idl_files();
+  if (known(key)) return load(key, 0);
+  if (ros && key.find("::") == std::string::npos) return load(pkg + "/msg/" + name, 0);  // the usual error
+  throw MsgError("unknown message type '" + key + "': no .idl file of --msg-path defines it" +
+                 (ros ? ", and there is no ROS 2 type " + pkg + "/msg/" + name : std::string()) + idl_scan_errors_);
 }
 
-const MessageType& TypeRegistry::load(const std::string& package, const std::string& name, int depth) {
-  const std::string full = package + "/msg/" + name;
-  auto it = types_.find(full);
+const MessageType& TypeRegistry::load(const std::string& key, int depth) {
+  auto it = types_.find(key);
   if (it != types_.end()) {
-    if (!it->second) throw MsgError("message type " + full + " contains itself");
+    if (!it->second) throw MsgError("message type " + key + " contains itself");
     return *it->second;
   }
-  if (depth > 64) throw MsgError("message types nested deeper than 64 levels at " + full);
-  std::string text, source;
-  if (!find_text(package, name, text, source)) {
-    std::string where = search_paths_.empty() ? "no --msg-path given" : "searched --msg-path";
-    for (const auto& d : search_paths_) where += " " + d;
-    throw MsgError("unknown message type " + full + ": not bundled with rvc, not in a bag schema, " + where);
+  if (depth > 64) throw MsgError("message types nested deeper than 64 levels at " + key);
+  std::unique_ptr<MessageType> type;
+  std::string pkg, name, text, source;
+  if (!idl_.count(key) && key.find('/') == std::string::npos) scan_idl_files();  // a plain IDL name
+  if (auto idl = idl_.find(key); idl != idl_.end()) {
+    type = std::make_unique<MessageType>(idl->second);
+  } else if (key.find('/') != std::string::npos && split_type_name(key, pkg, name)) {
+    switch (find_definition(pkg, name, text, source)) {
+      case Found::Msg: type = std::make_unique<MessageType>(parse_msg(pkg, name, text, source)); break;
+      case Found::Idl: type = std::make_unique<MessageType>(idl_.at(key)); break;
+      case Found::None: {
+        std::string where = search_paths_.empty() ? "no --msg-path given" : "searched --msg-path";
+        for (const auto& d : search_paths_) where += " " + d;
+        throw MsgError("unknown message type " + key + ": not bundled with rvc, not in a bag schema, " + where);
+      }
+    }
+  } else {
+    throw MsgError("unknown message type " + key + ": no .idl file of --msg-path defines it" + idl_scan_errors_);
   }
-  auto type = std::make_unique<MessageType>(parse_msg(package, name, text, source));
-  types_[full] = nullptr;  // loading: a reference back to it is a cycle
+  source = type->source;
+  types_[key] = nullptr;  // loading: a reference back to it is a cycle
   for (auto& f : type->fields) {
     if (f.type.prim != Prim::Message) continue;
-    std::string fp, fn;
-    split_type_name(f.type.type_name, fp, fn);
     try {
-      f.type.message = &load(fp, fn, depth + 1);
+      f.type.message = &load(f.type.type_name, depth + 1);
     } catch (const MsgError& e) {
-      types_.erase(full);
-      throw MsgError(std::string(e.what()) + "\n  used by field '" + f.name + "' of " + full + " (" + source + ":" +
+      types_.erase(key);
+      throw MsgError(std::string(e.what()) + "\n  used by field '" + f.name + "' of " + key + " (" + source + ":" +
                      std::to_string(f.line) + ")");
     }
   }
-  auto& slot = types_[full];
+  auto& slot = types_[key];
   slot = std::move(type);
   return *slot;
 }

@@ -2,10 +2,13 @@
 // definitions added in-process (an MCAP bag's schemas), folders given with
 // --msg-path, and the definitions bundled with rvc (builtin_interfaces,
 // std_msgs, geometry_msgs and the Autoware messages of the paper's Table 3).
+// Definitions are ROS 2 .msg files or OMG IDL (.idl, see idl_parser.hpp):
+// ROS 2 types by pkg/msg/Name, plain DDS IDL types by their scoped name.
 #pragma once
 
 #include <map>
 #include <memory>
+#include <set>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -20,26 +23,43 @@ class TypeRegistry {
   TypeRegistry();
 
   // A folder of definitions: a ROS 2 install or share/ tree (<dir>/<pkg>/msg/<Name>.msg,
-  // <dir>/share/<pkg>/msg/<Name>.msg) or a plain folder (<dir>/<Name>.msg, any package).
+  // <dir>/share/<pkg>/msg/<Name>.msg) or a plain folder (<dir>/<Name>.msg, any package);
+  // <Name>.idl beside or instead of <Name>.msg. Or one .idl file, read at once.
   void add_search_path(const std::string& dir);
+  // Every struct of an IDL text (a file, a bag's schema).
+  void add_idl(std::string_view text, const std::string& source);
   // One definition's text, e.g. from a bag's schema record.
   void add_definition(const std::string& type_name, std::string text, const std::string& source);
   // An MCAP "ros2msg" schema: the type's definition followed by those it uses,
   // each after a line of '=' and a line "MSG: pkg/Name".
   void add_concatenated(const std::string& type_name, std::string_view text, const std::string& source);
 
+  // An MCAP "ros2idl" schema: IDL texts, each after a line of '=' and a line "IDL: pkg/msg/Name".
+  void add_concatenated_idl(std::string_view text, const std::string& source);
+
   // The type and every type it uses, parsed and linked. Accepts "pkg/msg/Name",
-  // "pkg/Name" and the DDS name "pkg::msg::dds_::Name_". Throws MsgError.
+  // "pkg/Name", the DDS name "pkg::msg::dds_::Name_" and plain IDL names
+  // ("KeyedSeq", "vehicle::Speed"; these are looked for in every .idl file
+  // of the search folders). Throws MsgError.
   const MessageType& resolve(std::string_view type_name);
 
   // Names of the bundled types ("pkg/msg/Name"), sorted.
   static std::vector<std::string> bundled_types();
 
  private:
-  const MessageType& load(const std::string& package, const std::string& name, int depth);
-  bool find_text(const std::string& package, const std::string& name, std::string& text, std::string& source) const;
+  enum class Found { None, Msg, Idl };
+  const MessageType& load(const std::string& key, int depth);
+  bool known(const std::string& key) const { return types_.count(key) || idl_.count(key); }
+  // .msg text (Msg), or an .idl file now in idl_ (Idl), in the registry's order.
+  Found find_definition(const std::string& package, const std::string& name, std::string& text, std::string& source);
+  void read_idl_file(const std::string& path);
+  void scan_idl_files();
 
   std::vector<std::string> search_paths_;
+  std::map<std::string, MessageType> idl_;                          // full name -> parsed, unlinked
+  std::set<std::string> idl_files_read_;
+  bool idl_scanned_ = false;
+  std::string idl_scan_errors_;
   std::map<std::string, std::pair<std::string, std::string>> added_;  // full name -> (text, source)
   std::map<std::string, std::unique_ptr<MessageType>> types_;        // full name -> linked type
 };

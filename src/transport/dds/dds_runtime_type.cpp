@@ -2,6 +2,7 @@
 
 #include <dds/ddsc/dds_opcodes.h>
 
+#include <deque>
 #include <map>
 #include <stdexcept>
 
@@ -119,6 +120,7 @@ class OpsBuilder {
   std::vector<uint32_t> build(const MessageType& top) {
     order(top);
     for (const MessageType* m : queue_) emit_block(*m);
+    emit_keys(top);
     for (const auto& p : patches_) {
       // A signed 16-bit jump: a nested type already emitted for an earlier
       // field (Time inside two different messages) lies behind the caller.
@@ -128,8 +130,42 @@ class OpsBuilder {
     return ops_;
   }
   uint32_t instructions() const { return instructions_; }
+  const std::vector<dds_key_descriptor_t>& keys() const { return keys_; }
+  uint32_t key_flags() const { return key_flags_; }
 
  private:
+  // Keys as idlc writes them: the key member's op gets FLAG_KEY and FLAG_MU,
+  // and after the last block one KOF op per key holds the index of that
+  // member's op; the key descriptor points at its KOF op. Only top-level
+  // primitive and string members (what #pragma keylist and @key give in
+  // data types); a key of 16 bytes or less (no strings) is "fixed".
+  void emit_keys(const MessageType& top) {
+    uint32_t xcdr1 = 0, xcdr2 = 0;
+    bool fixed = true;
+    for (size_t k = 0; k < top.keys.size(); ++k) {
+      size_t i = 0;
+      while (i < top.fields.size() && top.fields[i].name != top.keys[k]) ++i;
+      if (i == top.fields.size()) throw std::invalid_argument("dds: key '" + top.keys[k] + "' is no member of " + top.full_name());
+      const FieldType& t = top.fields[i].type;
+      if (t.prim == Prim::Message || t.array != ArrayKind::None)
+        throw std::invalid_argument("dds: key '" + top.keys[k] + "' of " + top.full_name() +
+                                    ": only primitive and string members can be keys");
+      ops_[top_insn_[i]] |= DDS_OP_FLAG_KEY | DDS_OP_FLAG_MU;
+      key_names_.push_back(top.keys[k]);
+      keys_.push_back({nullptr, static_cast<uint32_t>(ops_.size()), static_cast<uint32_t>(k)});
+      ops_.insert(ops_.end(), {static_cast<uint32_t>(DDS_OP_KOF) | 1u, static_cast<uint32_t>(top_insn_[i])});
+      const uint32_t size = static_cast<uint32_t>(msg::prim_size(t.prim));
+      if (size == 0) fixed = false;
+      xcdr1 = round_up(xcdr1, size ? size : 1) + size;
+      xcdr2 = round_up(xcdr2, size > 4 ? 4 : (size ? size : 1)) + size;
+    }
+    for (size_t k = 0; k < keys_.size(); ++k) keys_[k].m_name = key_names_[k].c_str();
+    if (!top.keys.empty() && fixed) {
+      if (xcdr1 <= 16) key_flags_ |= DDS_TOPIC_FIXED_KEY;
+      if (xcdr2 <= 16) key_flags_ |= DDS_TOPIC_FIXED_KEY_XCDR2;
+    }
+  }
+
   struct Patch {
     size_t word, insn;
     uint32_t insn_len;
@@ -158,7 +194,10 @@ class OpsBuilder {
       ++instructions_;
     } else {
       const auto offsets = layouts_.offsets(m);
-      for (size_t i = 0; i < m.fields.size(); ++i) emit_field(m.fields[i].type, offsets[i]);
+      for (size_t i = 0; i < m.fields.size(); ++i) {
+        if (&m == queue_.front()) top_insn_.push_back(ops_.size());
+        emit_field(m.fields[i].type, offsets[i]);
+      }
     }
     ops_.push_back(kRts);
     ++instructions_;
@@ -210,11 +249,16 @@ class OpsBuilder {
   std::map<const MessageType*, size_t> start_;
   std::vector<Patch> patches_;
   uint32_t instructions_ = 0;
+  std::vector<size_t> top_insn_;  // word index of each top-level member's op
+  std::vector<dds_key_descriptor_t> keys_;
+  std::deque<std::string> key_names_;  // stable addresses for m_name
+  uint32_t key_flags_ = 0;
 };
 
 }  // namespace
 
 std::string ros2_dds_type_name(const MessageType& type) {
+  if (!type.idl_name.empty()) return type.idl_name;  // a plain DDS IDL type keeps its own name
   return type.package + "::msg::dds_::" + type.name + "_";
 }
 
@@ -222,13 +266,21 @@ RuntimeTopicType::RuntimeTopicType(const MessageType& type) : type_name_(ros2_dd
   Layouts layouts;
   OpsBuilder builder(layouts);
   ops_ = builder.build(type);
+  key_names_.assign(builder.keys().size(), {});
+  keys_ = builder.keys();
+  for (size_t k = 0; k < keys_.size(); ++k) {
+    key_names_[k] = keys_[k].m_name;
+    keys_[k].m_name = key_names_[k].c_str();
+  }
   const Layout l = layouts.of_message(type);
   size_ = l.size;
   align_ = l.align;
   // No XTypes type information: peers match on the type name, as with
   // rmw_cyclonedds. NO_OPTIMIZE: CycloneDDS never memcpys a sample on the
   // strength of this layout (rvc reads and writes serialized data only).
-  desc_.reset(new dds_topic_descriptor_t{size_, align_, DDS_TOPIC_NO_OPTIMIZE, 0u, type_name_.c_str(), nullptr,
+  desc_.reset(new dds_topic_descriptor_t{size_, align_, DDS_TOPIC_NO_OPTIMIZE | builder.key_flags(),
+                                         static_cast<uint32_t>(keys_.size()), type_name_.c_str(),
+                                         keys_.empty() ? nullptr : keys_.data(),
                                          builder.instructions(), ops_.data(), "", {nullptr, 0}, {nullptr, 0}, 0u});
 }
 

@@ -1,7 +1,8 @@
 // A CycloneDDS topic descriptor built at run time from a ROS 2 message type
 // (src/msg), equal to what idlc generates for the IDL that rosidl derives from
 // the .msg: type name "pkg::msg::dds_::Name_", final extensibility, XCDR1, no
-// keys, empty messages with their one uint8 member. It lets rvc subscribe to
+// keys, empty messages with their one uint8 member. Plain DDS IDL types
+// (msg::MessageType::idl_name) keep their own name and their keys. It lets rvc subscribe to
 // any ROS 2 topic as raw CDR (dds_takecdr), with no generated code: CycloneDDS
 // uses the ops to check each sample it receives, rvc decodes the bytes itself
 // (src/io/cdr_codec).
@@ -38,6 +39,8 @@ class RuntimeTopicType {
  private:
   std::string type_name_;
   std::vector<uint32_t> ops_;
+  std::vector<std::string> key_names_;
+  std::vector<dds_key_descriptor_t> keys_;
   uint32_t size_ = 0, align_ = 1;
   std::unique_ptr<dds_topic_descriptor_t> desc_;
 };

@@ -44,7 +44,14 @@ void expect_same(const char* ros_name, const dds_topic_descriptor_t& idlc) {
   EXPECT_EQ(d.m_size, idlc.m_size);
   EXPECT_EQ(d.m_align, idlc.m_align);
   EXPECT_EQ(d.m_nops, idlc.m_nops);
-  EXPECT_EQ(d.m_nkeys, 0u);
+  EXPECT_EQ(d.m_nkeys, idlc.m_nkeys);
+  for (uint32_t k = 0; k < std::min(d.m_nkeys, idlc.m_nkeys); ++k) {
+    EXPECT_STREQ(d.m_keys[k].m_name, idlc.m_keys[k].m_name);
+    EXPECT_EQ(d.m_keys[k].m_offset, idlc.m_keys[k].m_offset) << "key " << k;
+    EXPECT_EQ(d.m_keys[k].m_idx, idlc.m_keys[k].m_idx) << "key " << k;
+  }
+  constexpr uint32_t kKeyFlags = DDS_TOPIC_FIXED_KEY | DDS_TOPIC_FIXED_KEY_XCDR2;
+  EXPECT_EQ(d.m_flagset & kKeyFlags, idlc.m_flagset & kKeyFlags);
   const auto ours = words(d), theirs = words(idlc);
   EXPECT_EQ(ours.size(), theirs.size());
   for (size_t i = 0; i < std::min(ours.size(), theirs.size()); ++i)
@@ -60,6 +67,41 @@ TEST(DdsRuntimeType, SameDescriptorAsIdlc) {
   expect_same("rvc_test_msgs/msg/Mixed", rvc_test_msgs_msg_dds__Mixed__desc);
   // Deep is reached through Inner before Wrap refers to it: a backward jump.
   expect_same("rvc_test_msgs/msg/Pair", rvc_test_msgs_msg_dds__Pair__desc);
+}
+
+// The same IDL file idlc compiled, read by rvc's IDL parser: its structs are
+// plain IDL types named as idlc names them, keys included.
+TEST(DdsRuntimeType, IdlFileGivesIdlcsDescriptors) {
+  msg::TypeRegistry reg;
+  reg.add_search_path(RVC_ORACLE_IDL);
+  auto same = [&](const char* name, const dds_topic_descriptor_t& idlc) {
+    SCOPED_TRACE(name);
+    RuntimeTopicType t(reg.resolve(name));
+    const dds_topic_descriptor_t& d = *t.descriptor();
+    EXPECT_STREQ(d.m_typename, idlc.m_typename);
+    EXPECT_EQ(d.m_size, idlc.m_size);
+    EXPECT_EQ(d.m_align, idlc.m_align);
+    EXPECT_EQ(d.m_nops, idlc.m_nops);
+    ASSERT_EQ(d.m_nkeys, idlc.m_nkeys);
+    for (uint32_t k = 0; k < d.m_nkeys; ++k) {
+      EXPECT_STREQ(d.m_keys[k].m_name, idlc.m_keys[k].m_name);
+      EXPECT_EQ(d.m_keys[k].m_offset, idlc.m_keys[k].m_offset) << "key " << k;
+      EXPECT_EQ(d.m_keys[k].m_idx, idlc.m_keys[k].m_idx) << "key " << k;
+    }
+    constexpr uint32_t kKeyFlags = DDS_TOPIC_FIXED_KEY | DDS_TOPIC_FIXED_KEY_XCDR2;
+    EXPECT_EQ(d.m_flagset & kKeyFlags, idlc.m_flagset & kKeyFlags);
+    const auto ours = words(d), theirs = words(idlc);
+    ASSERT_EQ(ours.size(), theirs.size());
+    for (size_t i = 0; i < ours.size(); ++i)
+      EXPECT_EQ(ours[i], theirs[i]) << "word " << i << " (op 0x" << std::hex << theirs[i] << ")";
+  };
+  same("builtin_interfaces::msg::dds_::Time_", builtin_interfaces_msg_dds__Time__desc);
+  same("rvc_test_msgs::msg::dds_::Mixed_", rvc_test_msgs_msg_dds__Mixed__desc);
+  same("rvc_test_msgs::msg::dds_::Pair_", rvc_test_msgs_msg_dds__Pair__desc);
+  same("rvc_test_msgs::msg::dds_::Nothing_", rvc_test_msgs_msg_dds__Nothing__desc);
+  same("rvc_keyed::KeyedSeq", rvc_keyed_KeyedSeq_desc);
+  same("rvc_keyed::TwoKeys", rvc_keyed_TwoKeys_desc);
+  same("rvc_keyed::Listed", rvc_keyed_Listed_desc);
 }
 
 TEST(DdsRuntimeType, TypeNameIsTheRos2DdsName) {

@@ -379,3 +379,46 @@ def test_typed_dense_time_is_the_stamp(rvc, tmp_path, types):
     bad = subprocess.run([rvc, "echo", topic, "--field", "stamp.seconds", *common], capture_output=True, text=True)
     assert bad.returncode == 2 and "no field 'seconds' in builtin_interfaces/msg/Time; its fields: sec, nanosec" \
         in bad.stderr, bad.stderr
+
+
+DDSPERF_IDL = """// ddsperf's KeyedSeq topic type (CycloneDDS's ddsperf_types.idl), a plain DDS type with a key
+struct KeyedSeq { unsigned long seq; unsigned long keyval; sequence<octet> baggage; };
+#pragma keylist KeyedSeq keyval
+"""
+
+
+def test_ddsperf_samples_of_an_idl_type_are_read(rvc, tmp_path):
+    """ddsperf (CycloneDDS's own tool, Debian cyclonedds-tools) publishes its keyed KeyedSeq type on
+    DDSPerfRDataKS; rvc reads it from the IDL above (DDS type name "KeyedSeq", key keyval, the topic
+    name as is): every sample echoed in order, the sequence numbers ddsperf wrote consecutive, the
+    baggage of the size asked for; a monitor's property over the fields holds."""
+    if "dds" not in transports_built(rvc):
+        pytest.fail("rvc built without DDS")
+    import shutil
+    ddsperf = shutil.which("ddsperf")
+    assert ddsperf, "ddsperf missing (Debian cyclonedds-tools; scripts/install-deps.sh installs it)"
+    idl = tmp_path / "ddsperf_types.idl"
+    idl.write_text(DDSPERF_IDL)
+    cfg = tmp_path / "lo.xml"
+    subprocess.run([rvc, "dds-config", "-o", str(cfg)], check=True)
+    common = ["--no-ros2-names", "--type", "KeyedSeq", "--msg-path", str(idl), "--domain", "17"]
+    echo = subprocess.Popen([rvc, "echo", "dds:DDSPerfRDataKS", *common, "-n", "400", "--idle-timeout", "20"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    mon = subprocess.Popen([rvc, "monitor", "--input", "dds:DDSPerfRDataKS", *common, "--idle-timeout", "3",
+                            "--spec", "historically({keyval == 0} && {baggage[51] >= 0})", "--output", "-"],
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    time.sleep(1.0)
+    env = dict(os.environ, CYCLONEDDS_URI=f"file://{cfg}")  # ddsperf pinned to lo like rvc
+    pub = subprocess.run([ddsperf, "-i", "17", "-D", "3", "pub", "500Hz", "size", "64"], env=env,
+                         capture_output=True, text=True, timeout=30)
+    assert pub.returncode == 0, pub.stderr
+    out, err = echo.communicate(timeout=HANG_GUARD)
+    assert echo.returncode == 0, err
+    rows = [json.loads(line) for line in out.splitlines()]
+    assert len(rows) == 400
+    seqs = [r["seq"] for r in rows]
+    assert seqs == list(range(seqs[0], seqs[0] + 400)), seqs[:10]
+    assert all(r["keyval"] == 0 and len(r["baggage"]) == 52 for r in rows)  # 64 B = 12 B fixed part + 52
+    mout, merr = mon.communicate(timeout=HANG_GUARD)
+    assert mon.returncode == 0, merr
+    assert json.loads(mout.splitlines()[0])["value"] is True
