@@ -123,7 +123,16 @@ JsonDecoder::JsonDecoder(const engine::AtomTable& atoms, DecoderOptions options)
     node->tests.push_back(static_cast<int>(id));
     if (tests[id].op == FOp::Present) presence_tests_.push_back(static_cast<int>(id));
   }
-  if (options_.need_time) child(root_, options_.time_field)->is_time = true;
+  if (options_.need_time) {
+    KeyNode* t = &root_;  // a path, as in specs: "header.stamp"
+    size_t start = 0;
+    for (size_t dot; (dot = options_.time_field.find('.', start)) != std::string::npos; start = dot + 1)
+      t = child(*t, options_.time_field.substr(start, dot - start));
+    t = child(*t, options_.time_field.substr(start));
+    t->time_part = 1;
+    for (const char* sec : {"sec", "secs"}) child(*t, sec)->time_part = 2;
+    for (const char* nsec : {"nanosec", "nsecs"}) child(*t, nsec)->time_part = 3;
+  }
   prepare(root_);
 }
 
@@ -150,7 +159,7 @@ void JsonDecoder::prepare(KeyNode& node) {
   }
   for (KeyNode& c : node.children) node.any_escaped_child = node.any_escaped_child || !c.raw_comparable;
   node.raw_comparable = node.name.find_first_of("\"\\") == std::string::npos;
-  if (node.tests.empty() || !node.children.empty() || node.is_time) return;
+  if (node.tests.empty() || !node.children.empty() || node.time_part) return;
   bool all_bool = true, all_number = true;
   for (int id : node.tests) {
     const spec::FieldTest& t = atoms_.tests()[id];
@@ -204,7 +213,9 @@ __attribute__((always_inline)) inline bool JsonDecoder::fast_path(KeyNode& node,
 JsonDecoder::KeyNode* JsonDecoder::child(KeyNode& parent, const std::string& name) {
   for (KeyNode& c : parent.children)
     if (c.name == name) return &c;
-  parent.children.push_back(KeyNode{name, {}, {}, false, 0});
+  KeyNode node;
+  node.name = name;
+  parent.children.push_back(std::move(node));
   return &parent.children.back();
 }
 
@@ -291,15 +302,28 @@ bool JsonDecoder::decode_value(KeyNode& target, simdjson::ondemand::value value,
   if (auto err = value.type().get(type)) {
     return invalid(error, err);
   }
-  if (target.is_time && at_root) {
+  if (target.time_part == 1) {
     double t;
-    if (type != json_type::number || value.get_double().get(t)) {
-      error = "time field \"" + options_.time_field + "\" must be a number, not " + type_name(type);
+    if (type == json_type::object) {  // a builtin_interfaces/Time: its parts come as its children
+      saw_sec_ = false;
+      time_sec_ = time_nsec_ = 0;
+    } else if (type != json_type::number || value.get_double().get(t)) {
+      error = "time field \"" + options_.time_field + "\" must be a number of seconds or a Time {sec, nanosec}, not " +
+              type_name(type);
+      return false;
+    } else {
+      saw_time_ = true;
+      next_time_ = t;
+    }
+    // The time field may also be tested by atoms; re-reading a number is cheap.
+  } else if (target.time_part >= 2) {
+    double part;
+    if (type != json_type::number || value.get_double().get(part)) {
+      error = "time field \"" + options_.time_field + "." + target.name + "\" must be a number, not " + type_name(type);
       return false;
     }
-    saw_time_ = true;
-    next_time_ = t;
-    // The time field may also be tested by atoms; re-reading a number is cheap.
+    if (target.time_part == 2) saw_sec_ = true, time_sec_ = part;
+    else time_nsec_ = part;
   }
   if (type == json_type::object && !target.children.empty()) {
     simdjson::ondemand::object inner;
@@ -309,6 +333,14 @@ bool JsonDecoder::decode_value(KeyNode& target, simdjson::ondemand::value value,
     if (!decode_object(inner, target, error, warnings)) return false;
     for (int id : target.tests)
       if (atoms_.tests()[id].op == FOp::Present) next_[id] = 1;
+    if (target.time_part == 1) {
+      if (!saw_sec_) {
+        error = "time field \"" + options_.time_field + "\" is an object without \"sec\" (a Time is {sec, nanosec})";
+        return false;
+      }
+      saw_time_ = true;
+      next_time_ = (time_sec_ * 1e9 + time_nsec_) / 1e9;  // as the typed path computes a Time (same double)
+    }
     return true;
   }
   if (type == json_type::array && !target.by_index.empty()) {  // {ranges[0] < 0.5}

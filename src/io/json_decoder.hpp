@@ -54,7 +54,9 @@ class JsonDecoder {
     std::string name;
     std::vector<int> tests;          // atom ids testing this field
     std::vector<KeyNode> children;   // nested fields (a.b.c)
-    bool is_time = false;
+    // The time (--time-field, a path): 1 the field itself, a number of seconds or a
+    // builtin_interfaces/Time object; 2 its seconds (sec, ROS 1 secs); 3 its nanoseconds (nanosec, nsecs).
+    uint8_t time_part = 0;
     bool raw_comparable = true;      // name has no quote/backslash: compare raw JSON key bytes
     bool any_escaped_child = false;  // some child needs the unescaped-key comparison
     // Messages of one topic list their fields in the same order, so each
@@ -93,6 +95,8 @@ class JsonDecoder {
   std::vector<uint8_t> current_, next_;
   double time_ = 0, next_time_ = 0;
   bool saw_time_ = false;
+  double time_sec_ = 0, time_nsec_ = 0;  // parts of a Time object
+  bool saw_sec_ = false;
   bool malformed_ = false;
   uint32_t generation_ = 0;
 };

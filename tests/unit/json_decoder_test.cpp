@@ -414,15 +414,39 @@ TEST(JsonDecoderTime, RequiredInDense) {
   EXPECT_TRUE(contains(d.error, "missing time field \"time\"")) << d.error;
   EXPECT_EQ(d["p"], 0);  // rejected: not committed
   EXPECT_FALSE(d.feed(R"({"time": "noon", "p": true})"));
-  EXPECT_TRUE(contains(d.error, "time field \"time\" must be a number, not a string")) << d.error;
-  EXPECT_FALSE(d.feed(R"({"time": {"sec": 1}})"));
-  EXPECT_TRUE(contains(d.error, "must be a number, not an object")) << d.error;
+  EXPECT_TRUE(contains(d.error, "time field \"time\" must be a number of seconds or a Time {sec, nanosec}, not a string"))
+      << d.error;
+  EXPECT_FALSE(d.feed(R"({"time": {"nanosec": 1}})"));
+  EXPECT_TRUE(contains(d.error, "is an object without \"sec\"")) << d.error;
+  EXPECT_FALSE(d.feed(R"({"time": {"sec": "1"}})"));
+  EXPECT_TRUE(contains(d.error, "time field \"time.sec\" must be a number, not a string")) << d.error;
   ASSERT_TRUE(d.feed(R"({"p": true, "time": 1.5})")) << d.error;
   EXPECT_EQ(d.time(), 1.5);
   EXPECT_EQ(d["p"], 1);
   ASSERT_TRUE(d.feed(R"({"time": 4})")) << d.error;
   EXPECT_EQ(d.time(), 4);
   EXPECT_EQ(d["p"], 1);
+}
+
+// A stamp as ROS 2 JSON writes it (builtin_interfaces/Time, also ROS 1's secs/nsecs), at a path:
+// the same double the typed path computes, (sec * 1e9 + nanosec) / 1e9.
+TEST(JsonDecoderTime, TimeObjectAtAPath) {
+  DecoderOptions o;
+  o.need_time = true;
+  o.time_field = "header.stamp";
+  Decoder d({"{header.stamp.sec > 5}", "{x}"}, o, engine::TimeModel::Dense);
+  ASSERT_TRUE(d.feed(R"({"header": {"frame_id": "a", "stamp": {"sec": 1700000000, "nanosec": 123}}, "x": true})"))
+      << d.error;
+  EXPECT_EQ(d.time(), (1700000000 * 1e9 + 123) / 1e9);
+  EXPECT_EQ(d["header.stamp.sec > 5"], 1);  // the stamp's fields are still tested
+  EXPECT_EQ(d["x"], 1);
+  ASSERT_TRUE(d.feed(R"({"header": {"stamp": {"nsecs": 500000000, "secs": 2}}})")) << d.error;
+  EXPECT_EQ(d.time(), 2.5);
+  EXPECT_EQ(d["header.stamp.sec > 5"], 1);  // no "sec" in this one: the field keeps its last value
+  ASSERT_TRUE(d.feed(R"({"header": {"stamp": 7.25}})")) << d.error;
+  EXPECT_EQ(d.time(), 7.25);
+  EXPECT_FALSE(d.feed(R"({"header": {"frame_id": "a"}})"));
+  EXPECT_TRUE(contains(d.error, "missing time field \"header.stamp\"")) << d.error;
 }
 
 TEST(JsonDecoderTime, CustomTimeFieldAndNotRequiredInDiscrete) {
