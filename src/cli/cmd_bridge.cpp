@@ -30,6 +30,7 @@ struct Route {
   std::string from, to;
   std::unique_ptr<transport::Sink> sink;
   std::unique_ptr<transport::Source> source;
+  transport::TransportOptions transports;  // the bridge's, with this route's type
   std::atomic<uint64_t> forwarded{0};
   std::atomic<uint64_t> eos_count{0};
 };
@@ -48,6 +49,15 @@ struct BridgeCommand {
       std::fprintf(stderr, "rvc bridge: give endpoints in pairs: FROM TO [FROM TO]...\n");
       return kUsage;
     }
+    // One --type for every route, or one per route in the routes' order (a
+    // typed allow-list: the nine Autoware topics, each with its own type).
+    const std::vector<std::string> types = typed.type_option ? typed.type_option->results() : std::vector<std::string>{};
+    const size_t n_routes = uris.size() / 2;
+    if (types.size() > 1 && types.size() != n_routes) {
+      std::fprintf(stderr, "rvc bridge: %zu --type for %zu routes: give one for all routes or one per route\n",
+                   types.size(), n_routes);
+      return kUsage;
+    }
     typed.resolve(transports);
     std::vector<std::unique_ptr<Route>> routes;
     for (size_t i = 0; i < uris.size(); i += 2) {
@@ -62,13 +72,17 @@ struct BridgeCommand {
       auto r = std::make_unique<Route>();
       r->from = uris[i];
       r->to = uris[i + 1];
+      r->transports = transports;
+#ifdef RVC_HAVE_DDS
+      if (types.size() > 1) r->transports.dds.ros_type = &typed.registry.resolve(types[i / 2]);
+#endif
       routes.push_back(std::move(r));
     }
     install_stop_signals();
     // Sinks first, and wait for their subscribers: a source that starts
     // forwarding before the far side listens would lose the first messages.
     for (auto& r : routes) {
-      r->sink = transport::open_sink(r->to, transports);
+      r->sink = transport::open_sink(r->to, r->transports);
       if (wait_subscribers > 0) {
         std::fprintf(stderr, "rvc bridge: waiting for %zu subscriber%s on %s ...\n", wait_subscribers,
                      wait_subscribers == 1 ? "" : "s", r->to.c_str());
@@ -85,7 +99,7 @@ struct BridgeCommand {
     for (auto& r : routes) {
       // dds: -> anything but dds: forwards on CycloneDDS's receive thread; a
       // dds: sink may wait for acknowledgements that only that thread receives.
-      transport::TransportOptions from_opts = transports;
+      transport::TransportOptions from_opts = r->transports;
 #ifdef RVC_HAVE_DDS
       from_opts.dds.deliver_on_receive_thread = transport::scheme_of(r->to) != "dds";
 #endif
@@ -149,7 +163,8 @@ Runner register_bridge(CLI::App& app) {
   sub->add_option("--stats-interval", cmd->stats_interval, "Print forwarded counts every S seconds (stderr)");
   cmd->typed.add_to(*sub,
                   "ROS 2 message type of the samples, pkg/msg/Name: dds: endpoints are topics of this type (as ROS 2 "
-                  "nodes publish them), zenoh: endpoints carry their CDR (as zenoh-bridge-ros2dds does)");
+                  "nodes publish them), zenoh: endpoints carry their CDR (as zenoh-bridge-ros2dds does); "
+                  "repeat it once per route to give each route its own type");
   add_transport_options(*sub, cmd->transports);
   return [cmd] { return cmd->run(); };
 }
