@@ -21,7 +21,6 @@ import argparse
 import csv
 import json
 import os
-import re
 import socket
 import subprocess
 import sys
@@ -29,7 +28,7 @@ import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "bench"))
-from timescales_bench import FAMILIES, BOUNDS, machine, best_of  # noqa: E402
+from timescales_bench import FAMILIES, BOUNDS, machine, best_of, write_marked  # noqa: E402
 
 
 def free_port():
@@ -159,15 +158,8 @@ def main():
     with open(os.path.join(out, f"network-batch{args.batch}.md"), "w") as f:
         f.write(md)
     if not args.no_docs:
-        path = os.path.join(ROOT, "docs", "performance.md")
-        text = open(path).read()
         tag = "network" if args.batch == 1 else f"network-batch{args.batch}"
-        block = f"<!-- {tag}:begin -->\n" + md + f"<!-- {tag}:end -->"
-        if f"<!-- {tag}:begin -->" in text:
-            text = re.sub(rf"<!-- {tag}:begin -->.*?<!-- {tag}:end -->", lambda _: block, text, flags=re.S)
-        else:
-            text += "\n" + block + "\n"
-        open(path, "w").write(text)
+        write_marked(os.path.join(ROOT, "docs", "performance.md"), tag, md)
     print(md)
 
 

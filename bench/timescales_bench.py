@@ -174,13 +174,21 @@ def plot(rows, path):
     fig.savefig(path, dpi=110)
 
 
-def update_docs(md):
-    path = os.path.join(ROOT, "docs", "performance.md")
-    text = open(path).read() if os.path.exists(path) else "# Performance\n\n<!-- timescales:begin -->\n<!-- timescales:end -->\n"
-    block = "<!-- timescales:begin -->\n" + md + "<!-- timescales:end -->"
-    text = re.sub(r"<!-- timescales:begin -->.*?<!-- timescales:end -->", lambda _: block, text, flags=re.S)
+def write_marked(path, tag, md):
+    """Puts `md` between the <!-- TAG:begin --> and <!-- TAG:end --> markers of a doc (appended with
+    the markers if it has none): the benchmarks' tables live in docs written by hand around them."""
+    text = open(path).read() if os.path.exists(path) else ""
+    block = f"<!-- {tag}:begin -->\n" + md + f"<!-- {tag}:end -->"
+    if f"<!-- {tag}:begin -->" in text:
+        text = re.sub(rf"<!-- {tag}:begin -->.*?<!-- {tag}:end -->", lambda _: block, text, flags=re.S)
+    else:
+        text += "\n" + block + "\n"
     with open(path, "w") as f:
         f.write(text)
+
+
+def update_docs(md):
+    write_marked(os.path.join(ROOT, "docs", "performance.md"), "timescales", md)
 
 
 if __name__ == "__main__":

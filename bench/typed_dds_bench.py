@@ -28,7 +28,7 @@ import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "bench"))
-from timescales_bench import machine  # noqa: E402
+from timescales_bench import machine, write_marked  # noqa: E402
 
 IDL = os.path.join(ROOT, "bench", "ddsperf", "ddsperf_types.idl")
 SPEC = "historically({keyval == 0} && {seq >= 0})"
@@ -165,14 +165,7 @@ def main():
     md = render(rows, args)
     print(md)
     if not args.no_docs:
-        path = os.path.join(ROOT, "docs", "performance.md")
-        text = open(path).read()
-        block = "<!-- typed-dds:begin -->\n" + md + "<!-- typed-dds:end -->"
-        if "<!-- typed-dds:begin -->" in text:
-            text = re.sub(r"<!-- typed-dds:begin -->.*?<!-- typed-dds:end -->", lambda _: block, text, flags=re.S)
-        else:
-            text += "\n" + block + "\n"
-        open(path, "w").write(text)
+        write_marked(os.path.join(ROOT, "docs", "performance.md"), "typed-dds", md)
 
 
 def render(rows, args):

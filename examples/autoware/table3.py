@@ -10,13 +10,14 @@ bench/results/autoware.jsonl. A benchmark, not a test (the container tier runs a
 import argparse
 import json
 import os
-import re
 import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, HERE)
+sys.path.insert(0, os.path.join(ROOT, "bench"))
 import deploy  # noqa: E402
+from timescales_bench import write_marked  # noqa: E402
 
 
 def render(results):
@@ -103,11 +104,7 @@ def main():
     md = render(results)
     print(md)
     plot(results, os.path.join(ROOT, "docs", "img", "autoware-rates.png"))
-    doc = os.path.join(ROOT, "docs", "autoware.md")
-    text = open(doc).read()
-    block = "<!-- table3:begin -->\n" + md + "<!-- table3:end -->"
-    text = re.sub(r"<!-- table3:begin -->.*?<!-- table3:end -->", lambda _: block, text, flags=re.S)
-    open(doc, "w").write(text)
+    write_marked(os.path.join(ROOT, "docs", "autoware.md"), "table3", md)
 
 
 if __name__ == "__main__":
