@@ -209,3 +209,51 @@ def test_broken_bags_are_named(rvc, tmp_path, typestore):
     junk.write_bytes(data[:8] + bytes(random.Random(1).randrange(256) for _ in range(300)))
     r = run([rvc, "check", "--spec", "{report == 2}", str(junk)])
     assert r.returncode == 2 and "junk.mcap" in r.stderr, r.stderr
+
+
+GEAR_IDL = """#include "builtin_interfaces/msg/Time.idl"
+module idlbag_msgs { module msg {
+  module Gear_Constants { const uint8 DRIVE = 2; const uint8 REVERSE = 20; };
+  struct Gear { builtin_interfaces::msg::Time stamp; uint8 report; float speed; };
+}; };
+"""
+TIME_IDL = """module builtin_interfaces { module msg {
+  struct Time { int32 sec; uint32 nanosec; };
+}; };
+"""
+
+
+def test_bag_with_idl_schemas_checks_like_its_json(rvc, tmp_path):
+    """A bag whose schema is `ros2idl` (written with the mcap package, samples by rosbags from the same
+    IDL): the type comes from the bag; verdicts equal `rvc check` on the values as JSON (with numbers
+    for the constants, which JSON has no type to take from)."""
+    from mcap.writer import Writer
+    from rosbags.typesys import Stores, get_typestore, get_types_from_idl
+    if "zenoh" not in transports_built(rvc):  # the MCAP reader lives in the Rust library
+        pytest.fail("this rvc was built without its Rust library (RVC_WITH_ZENOH=OFF): no MCAP")
+    ts = get_typestore(Stores.EMPTY)
+    ts.register(get_types_from_idl(TIME_IDL))
+    ts.register(get_types_from_idl(GEAR_IDL.split("\n", 1)[1]))  # rosbags' reader takes no #include
+    Gear, Time = ts.types["idlbag_msgs/msg/Gear"], ts.types["builtin_interfaces/msg/Time"]
+    rng = random.Random(3)
+    rows, bag = [], tmp_path / "gear.mcap"
+    schema = GEAR_IDL + "=" * 80 + "\nIDL: builtin_interfaces/msg/Time\n" + TIME_IDL
+    with open(bag, "wb") as f:
+        w = Writer(f)
+        w.start(profile="ros2")
+        sid = w.register_schema(name="idlbag_msgs/msg/Gear", encoding="ros2idl", data=schema.encode())
+        cid = w.register_channel(topic="/gear", message_encoding="cdr", schema_id=sid)
+        t = 1_700_000_000 * 10**9
+        for _ in range(200):
+            t += rng.choice([20, 40]) * 10**6
+            report, speed = rng.choice([2, 2, 20]), float(rng.choice([0.0, 0.0, 1.5, -0.5]))
+            m = Gear(stamp=Time(sec=t // 10**9, nanosec=t % 10**9), report=report, speed=speed)
+            w.add_message(channel_id=cid, log_time=t, publish_time=t, data=bytes(ts.serialize_cdr(m, "idlbag_msgs/msg/Gear")))
+            rows.append({"stamp": {"sec": t // 10**9, "nanosec": t % 10**9}, "report": report, "speed": speed})
+        w.finish()
+    trace = tmp_path / "gear.jsonl"
+    trace.write_text("".join(json.dumps(r) + "\n" for r in rows))
+    typed = run([rvc, "check", str(bag), "--all", "--spec", "{report == REVERSE} -> {speed <= 0}"])
+    plain = run([rvc, "check", str(trace), "--all", "--spec", "{report == 20} -> {speed <= 0}"])
+    assert typed.returncode == plain.returncode == 1, (typed.stderr, plain.stderr)
+    assert typed.stdout == plain.stdout and len(typed.stdout.splitlines()) == 200
