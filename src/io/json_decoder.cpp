@@ -287,14 +287,14 @@ bool JsonDecoder::decode_object(simdjson::ondemand::object object, KeyNode& node
       }
       continue;
     }
-    if (!decode_value(*target, value, &node == &root_, error, warnings)) return false;
+    if (!decode_value(*target, value, error, warnings)) return false;
   }
   return true;
 }
 
 // One value of a field (or array element) some test reads: its tests, its
 // nested fields and elements, and the time.
-bool JsonDecoder::decode_value(KeyNode& target, simdjson::ondemand::value value, bool at_root, std::string& error,
+bool JsonDecoder::decode_value(KeyNode& target, simdjson::ondemand::value value, std::string& error,
                                std::vector<std::string>* warnings) {
   target.seen = generation_;
   if (target.kind != Kind::General && fast_path(target, value)) return true;
@@ -384,7 +384,7 @@ bool JsonDecoder::decode_array(simdjson::ondemand::array elements, KeyNode& node
       }
       continue;
     }
-    if (!decode_value(*child, v, false, error, warnings)) return false;
+    if (!decode_value(*child, v, error, warnings)) return false;
   }
   return true;
 }

@@ -80,7 +80,7 @@ class JsonDecoder {
   bool decode_object(simdjson::ondemand::object object, KeyNode& node, std::string& error,
                      std::vector<std::string>* warnings);
   bool invalid(std::string& error, simdjson::error_code err, const std::string& field = {});
-  bool decode_value(KeyNode& target, simdjson::ondemand::value value, bool at_root, std::string& error,
+  bool decode_value(KeyNode& target, simdjson::ondemand::value value, std::string& error,
                     std::vector<std::string>* warnings);
   bool decode_array(simdjson::ondemand::array elements, KeyNode& node, std::string& error,
                     std::vector<std::string>* warnings);
