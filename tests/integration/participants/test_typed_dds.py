@@ -258,10 +258,7 @@ def test_typed_verdicts_reach_a_python_subscriber(rvc, tmp_path, types):
                             "rvc_msgs/msg/Verdict", "--wait-subscribers", "1", "--domain", str(domain),
                             "--idle-timeout", "3"], stderr=subprocess.PIPE, text=True)
     try:
-        rep = subprocess.run([rvc, "replay", str(trace), "--to", "dds:/vehicle/status/gear_status", "--type", GEAR,
-                              "--domain", str(domain), "--no-progress"], capture_output=True, text=True,
-                             timeout=HANG_GUARD)
-        assert rep.returncode == 0, rep.stderr
+        replay_gear(rvc, trace, domain)
         _, err = mon.communicate(timeout=HANG_GUARD)
         assert mon.returncode == 1, err  # the spec is violated at step 4
     finally:
@@ -278,6 +275,14 @@ def test_typed_verdicts_reach_a_python_subscriber(rvc, tmp_path, types):
     assert [{"time": v.time, "property": v.property, "value": v.value} for v in got] == expected
 
 
+def replay_gear(rvc, trace, domain):
+    """Publishes the JSON lines of `trace` as GearReport samples on /vehicle/status/gear_status."""
+    rep = subprocess.run([rvc, "replay", str(trace), "--to", "dds:/vehicle/status/gear_status", "--type", GEAR,
+                          "--domain", str(domain), "--no-progress"], capture_output=True, text=True,
+                         timeout=HANG_GUARD)
+    assert rep.returncode == 0, rep.stderr
+
+
 def test_typed_replay_to_monitor_with_constants(rvc, tmp_path, types):
     """rvc to rvc over a typed topic of the paper's Table 3, with a message constant in the spec."""
     domain = 190 + os.getpid() % 30
@@ -290,10 +295,7 @@ def test_typed_replay_to_monitor_with_constants(rvc, tmp_path, types):
                             "--type", GEAR, "--domain", str(domain), "--idle-timeout", "2"],
                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
-        rep = subprocess.run([rvc, "replay", str(trace), "--to", "dds:/vehicle/status/gear_status", "--type", GEAR,
-                              "--domain", str(domain), "--no-progress"], capture_output=True, text=True,
-                             timeout=HANG_GUARD)
-        assert rep.returncode == 0, rep.stderr
+        replay_gear(rvc, trace, domain)
         out, err = mon.communicate(timeout=HANG_GUARD)
         numeric = tmp_path / "numeric.jsonl"
         numeric.write_text(trace.read_text())
@@ -422,3 +424,16 @@ def test_ddsperf_samples_of_an_idl_type_are_read(rvc, tmp_path):
     mout, merr = mon.communicate(timeout=HANG_GUARD)
     assert mon.returncode == 0, merr
     assert json.loads(mout.splitlines()[0])["value"] is True
+
+
+def test_bridge_takes_one_type_for_all_routes_or_one_per_route(rvc, tmp_path):
+    """Several --type on `rvc bridge` give each route its type in order (the Autoware setup 2 bridges
+    nine topics of nine types); a count that fits neither is refused before anything is opened, and an
+    unknown type of any route is named."""
+    routes = ["dds:/a", f"file:{tmp_path}/a.cdr", "dds:/b", f"file:{tmp_path}/b.cdr"]  # no Zenoh needed
+    r = subprocess.run([rvc, "bridge", *routes, "--type", GEAR, "--type", GEAR, "--type", GEAR],
+                       capture_output=True, text=True, timeout=30)
+    assert r.returncode == 2 and "3 --type for 2 routes" in r.stderr, r.stderr
+    r = subprocess.run([rvc, "bridge", *routes, "--type", "nope_msgs/msg/Missing", "--type", GEAR],
+                       capture_output=True, text=True, timeout=30)
+    assert r.returncode == 2 and "unknown message type nope_msgs/msg/Missing" in r.stderr, r.stderr
