@@ -11,8 +11,8 @@ void CheckOptions::add_to(CLI::App& app) {
   app.add_flag("--all", all, "Report the verdict at every step, not only changes");
   app.add_flag("--strict", strict, "Reject messages missing a field a property tests, or with wrong types");
   app.add_option("--time-field", time_field,
-                 "Field holding the time in dense time (typed input: a path to a number or a Time; without it, "
-                 "the message's header.stamp or stamp)")
+                 "Field holding the time in dense time: a path (header.stamp) to seconds or a Time {sec, nanosec} "
+                 "(typed input without it: the message's header.stamp or stamp)")
       ->capture_default_str();
   app.add_option("--max-message-size", max_message_size, "Longest accepted message in bytes")->capture_default_str();
   app.add_option("--max-errors", max_reported, "Errors and warnings printed before going quiet (all are counted)")
