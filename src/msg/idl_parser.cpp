@@ -254,6 +254,8 @@ class Parser {
     annotations();
     const Token& at = cur();
     if (accept("module")) {
+      // Definitions nest by recursion: a bound keeps hostile input from exhausting the stack.
+      if (scope_.size() >= 64) fail(at, "modules nested deeper than 64 levels");
       scope_.push_back(ident("a module name"));
       expect("{");
       while (!is("}")) {
@@ -363,6 +365,8 @@ class Parser {
     FieldType t;
     if (accept("sequence")) {
       expect("<");
+      // Refused before recursing, so sequence<sequence<... cannot exhaust the stack.
+      if (is("sequence")) fail(at, "sequences of sequences or of arrays are not supported");
       FieldType inner = type_spec();
       if (inner.array != ArrayKind::None)
         fail(at, "sequences of sequences or of arrays are not supported");

@@ -191,6 +191,12 @@ TEST(IdlParser, BadIdlNamesLineAndColumn) {
   EXPECT_EQ(error_of("module m { struct S { long double x; }; };"),
             "bad.idl:1:23: long double is not supported (no ROS 2 or CDR mapping rvc reads)");
   EXPECT_EQ(error_of("module m {"), "bad.idl:1:11: module m not closed ('}' missing)");
+  std::string deep;
+  for (int i = 0; i < 100000; ++i) deep += "module m {";
+  EXPECT_EQ(error_of(deep), "bad.idl:1:641: modules nested deeper than 64 levels");
+  std::string seqs = "struct S { ";
+  for (int i = 0; i < 100000; ++i) seqs += "sequence<";
+  EXPECT_EQ(error_of(seqs), "bad.idl:1:12: sequences of sequences or of arrays are not supported");
 }
 
 }  // namespace
