@@ -1,6 +1,7 @@
 #include "msg/idl_parser.hpp"
 
 #include <cctype>
+#include <charconv>
 #include <map>
 #include <set>
 
@@ -509,6 +510,22 @@ class Parser {
     constants_[scope].push_back(std::move(c));
   }
 
+  // "0x1F" / "-0x1F" as decimal text; a malformed or out-of-range literal is
+  // an error at its position (std::stoll would throw past the parser).
+  std::string hex_value(const Token& at, const std::string& literal) {
+    const bool negative = !literal.empty() && literal[0] == '-';
+    const size_t x = literal.find_first_of("xX");
+    const char* first = literal.data() + x + 1;
+    const char* last = literal.data() + literal.size();
+    unsigned long long magnitude = 0;
+    auto [end, ec] = std::from_chars(first, last, magnitude, 16);
+    if (x != (negative ? 2u : 1u) || literal[x - 1] != '0' || first == last || end != last)
+      fail(at, "malformed hexadecimal literal '" + literal + "'");
+    if (ec == std::errc::result_out_of_range || magnitude > (negative ? 1ull << 63 : ~0ull))
+      fail(at, "hexadecimal literal '" + literal + "' does not fit in 64 bits");
+    return negative ? "-" + std::to_string(magnitude) : std::to_string(magnitude);
+  }
+
   // A constant expression: a literal, TRUE/FALSE, an earlier constant, with
   // an optional sign. (No arithmetic: rosidl and DDS data types need none.)
   double const_number(Prim prim, std::string* text = nullptr) {
@@ -520,7 +537,7 @@ class Parser {
     if (cur().kind == Token::Number) {
       value = sign + t_[p_++].text;
       if (value.find("0x") != std::string::npos || value.find("0X") != std::string::npos)
-        value = std::to_string(std::stoll(value, nullptr, 16));
+        value = hex_value(at, value);
       else if (!value.empty() && (value.back() == 'd' || value.back() == 'D'))
         value.pop_back();  // fixed-point suffix
     } else if (cur().kind == Token::Char) {

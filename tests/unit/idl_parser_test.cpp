@@ -86,6 +86,8 @@ constexpr const char* kPlainIdl = R"(
 /* A vehicle's plain DDS types (no ROS 2 naming) */
 module vehicle {
   const long MAX_WHEELS = 4;
+  const long long MASK = 0x1F;
+  const long long LOW = -0x8000000000000000;
   typedef double Vec3[3];
   typedef sequence<string<16>, 8> Names;
   enum Mode { MANUAL, @value(5) AUTO, SAFE_STOP };
@@ -125,6 +127,9 @@ TEST(IdlParser, PlainDdsIdl) {
   EXPECT_EQ(s.constant("AUTO")->number, 5);
   EXPECT_EQ(s.constant("SAFE_STOP")->number, 6);
   EXPECT_EQ(s.constant("MAX_WHEELS")->number, 4);
+  EXPECT_EQ(s.constant("MASK")->number, 31);
+  EXPECT_EQ(s.constant("MASK")->text, "31");
+  EXPECT_EQ(s.constant("LOW")->text, "-9223372036854775808");
   EXPECT_EQ(types[2].full_name(), "vehicle::nested::Ref");
   EXPECT_EQ(types[2].fields[0].type.type_name, "vehicle::Wheel");
   EXPECT_EQ(types[2].fields[1].type.type_name, "vehicle::Status");
@@ -191,6 +196,12 @@ TEST(IdlParser, BadIdlNamesLineAndColumn) {
   EXPECT_EQ(error_of("module m { struct S { long double x; }; };"),
             "bad.idl:1:23: long double is not supported (no ROS 2 or CDR mapping rvc reads)");
   EXPECT_EQ(error_of("module m {"), "bad.idl:1:11: module m not closed ('}' missing)");
+  // Found by fuzz_idl: a hex literal past 64 bits threw out of the parser.
+  EXPECT_EQ(error_of("const long long X = 0x10000000000000000;"),
+            "bad.idl:1:21: hexadecimal literal '0x10000000000000000' does not fit in 64 bits");
+  EXPECT_EQ(error_of("typedef string<0000000000000000000000000002000000000400x> S;"),
+            "bad.idl:1:16: malformed hexadecimal literal '0000000000000000000000000002000000000400x'");
+  EXPECT_EQ(error_of("const short X = 0x8000;"), "bad.idl:1:17: 32768 does not fit in int16");
   std::string deep;
   for (int i = 0; i < 100000; ++i) deep += "module m {";
   EXPECT_EQ(error_of(deep), "bad.idl:1:641: modules nested deeper than 64 levels");
