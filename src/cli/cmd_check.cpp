@@ -9,6 +9,8 @@
 
 #include "cli/check_options.hpp"
 #include "cli/commands.hpp"
+#include "cli/store_options.hpp"
+#include "io/json_writer.hpp"
 #include "cli/sync_options.hpp"
 #include "msg/type_registry.hpp"
 #include "runtime/check_stream.hpp"
@@ -27,13 +29,22 @@ std::string strip_file_scheme(const std::string& uri) { return uri.rfind("file:"
 struct CheckCommand {
   CheckOptions check;
   std::string input;
+  std::vector<std::string> outputs;  // verdict files (one) and a results database
   std::string output = "-";
+  StoreFlags store;
   bool summary = false;
   std::vector<std::string> topics;  // --topic: which topic(s) of a bag
   SyncFlags sync;                   // several topics
   msg::TypeRegistry registry;  // types from a bag's schemas
 
   int run() {
+    if (!store.take_database(outputs)) return kUsage;
+    if (outputs.size() > 1) {
+      std::fprintf(stderr, "rvc: check writes verdicts to one file (and a results database): %zu files given\n",
+                   outputs.size());
+      return kUsage;
+    }
+    if (!outputs.empty()) output = outputs[0];
     auto properties = check.properties();
     const std::string path = strip_file_scheme(input), opath = strip_file_scheme(output);
     if (path != "-" && opath != "-" && runtime::same_regular_file(path, opath)) {
@@ -58,14 +69,18 @@ struct CheckCommand {
     std::vector<std::unique_ptr<transport::Sink>> sinks;
     sinks.push_back(std::make_unique<transport::FileSink>(opath));
     runtime::VerdictOutputs outputs(std::move(sinks), !check.dense);
-    runtime::Pipeline pipeline(properties, check.pipeline_options(),
-                               [&](const engine::Verdict& v) { outputs.put(v); });
+    runtime::PipelineOptions popts = check.pipeline_options();
+    auto results = store.open();
+    if (results) results->attach(input, popts, outputs);
+    runtime::Pipeline pipeline(properties, popts, [&](const engine::Verdict& v) { outputs.put(v); });
+    if (results) results->start(runtime::run_info(command_line(), {input}, properties, check.dense));
     io::ReaderOptions ropts;
     ropts.max_line_bytes = check.max_message_size;
     // Reading stdin: show each verdict as soon as it is known.
     runtime::Outcome outcome = runtime::check_stream(fd, pipeline, outputs, ropts, path == "-");
     if (fd != 0) ::close(fd);
     report(pipeline.stats(), pipeline.violations());
+    if (results) results->finish(outcome, "end of input", counters_json(pipeline.stats(), pipeline.violations()));
     return outcome.exit_code();
   }
 
@@ -85,9 +100,19 @@ struct CheckCommand {
     std::vector<std::unique_ptr<transport::Sink>> sinks;
     sinks.push_back(std::make_unique<transport::FileSink>(opath));
     runtime::VerdictOutputs outputs(std::move(sinks), !check.dense);
-    const BagRun run = cli::run_bag(path, topics, properties, check.pipeline_options(), sync, registry, outputs);
+    runtime::PipelineOptions popts = check.pipeline_options();
+    auto results = store.open();
+    if (results) {
+      // A bag's properties are checked as the run starts: a bad spec ends it
+      // before any result, as it does without a database.
+      runtime::check_specs(properties, check.dense);
+      results->attach(input, popts, outputs);
+      results->start(runtime::run_info(command_line(), {input}, properties, check.dense));
+    }
+    BagRun run = cli::run_bag(path, topics, properties, popts, sync, registry, outputs);
     if (summary) std::fprintf(stderr, "rvc check: %s, %s\n", path.c_str(), run.description.c_str());
     report(run.stats, run.violations);
+    if (results) results->finish(run.outcome, "end of bag", counters_json(run.stats, run.violations));
     return run.outcome.exit_code();
 #else
     (void)properties;
@@ -96,6 +121,16 @@ struct CheckCommand {
                  path.c_str());
     return kUsage;
 #endif
+  }
+
+  // The run's counters for the results store.
+  static std::string counters_json(const runtime::PipelineStats& s, uint64_t violations) {
+    return io::JsonObject()
+        .add("checked", s.accepted)
+        .add("rejected", s.rejected)
+        .add("warnings", s.warnings)
+        .add("violations", violations)
+        .str();
   }
 
   void report(const runtime::PipelineStats& s, uint64_t violations) const {
@@ -120,7 +155,10 @@ Runner register_check(CLI::App& app) {
                   "The topic of a bag to check (needed when the bag holds several); repeatable: NAME=TOPIC (or TOPIC, "
                   "named by its last part), synchronized by --sync, tested as {NAME.field}");
   cmd->sync.add_to(*sub);
-  sub->add_option("--output,-o", cmd->output, "Where verdicts go: PATH, file:PATH or - (stdout)")->capture_default_str();
+  sub->add_option("--output,-o", cmd->outputs,
+                  "Where verdicts go: PATH, file:PATH or - (stdout, the default); also a results database: "
+                  "sqlite:PATH or postgresql://... (docs/results.md)");
+  cmd->store.add_to(*sub);
   sub->add_flag("--summary", cmd->summary, "Print message counts to stderr at the end");
   sub->footer(
       "Exit status: 0 all properties held, 1 a property was violated, 2 usage or spec error, 3 messages were\n"

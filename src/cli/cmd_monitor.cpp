@@ -10,6 +10,7 @@
 
 #include "cli/check_options.hpp"
 #include "cli/commands.hpp"
+#include "cli/store_options.hpp"
 #include "cli/transport_flags.hpp"
 #include "cli/signals.hpp"
 #include "io/json_writer.hpp"
@@ -48,6 +49,27 @@ struct MonitorCommand {
   double wait_timeout = 10;
   TypeOptions typed;                   // --type: payloads are CDR samples of this ROS 2 type
   std::vector<std::string> topics;     // --topic: of an mcap: input
+  StoreFlags store;                    // a results database among the outputs
+  std::unique_ptr<runtime::ResultsOutput> results;
+
+  // Records the run in the results database (if one is given) and hooks it
+  // to the pipeline's messages, the verdicts and the loop's counters.
+  void attach_results(const std::string& input_name, runtime::PipelineOptions& popts,
+                      runtime::VerdictOutputs& verdicts) {
+    results = store.open();
+    if (results) results->attach(input_name, popts, verdicts);
+  }
+  // Once the pipeline is built (its specs are valid).
+  void start_results(const std::vector<std::string>& input_uris, const std::vector<engine::PropertySpec>& properties) {
+    if (results) results->start(runtime::run_info(command_line(), input_uris, properties, check.dense));
+  }
+  void record_counters(runtime::LoopOptions& lopts) {
+    if (results) lopts.on_record = [this](const std::string& json) { results->counters(json); };
+  }
+  int finish_results(runtime::Outcome outcome, const runtime::MonitorLoop& loop) {
+    if (results) results->finish(outcome, runtime::to_string(loop.end_reason()), loop.final_stats());
+    return outcome.exit_code();
+  }
 
   // A ROS 2 bag: played through the runtime at once, its topic's type from
   // the bag's own schema (as `rvc check bag.mcap`).
@@ -61,7 +83,11 @@ struct MonitorCommand {
     const std::string path = input.substr(5);
     std::fprintf(stderr, "rvc monitor: %zu propert%s on %s -> %zu output%s\n", properties.size(),
                  properties.size() == 1 ? "y" : "ies", input.c_str(), verdicts.size(), verdicts.size() == 1 ? "" : "s");
-    const BagRun run = cli::run_bag(path, topics, properties, popts, sync, typed.registry, verdicts);
+    attach_results(input, popts, verdicts);
+    if (results)  // a bad spec ends the run before any result, as without a database
+      runtime::check_specs(properties, check.dense);
+    start_results({input}, properties);
+    BagRun run = cli::run_bag(path, topics, properties, popts, sync, typed.registry, verdicts);
     std::fprintf(stderr, "rvc monitor: %s\n", run.description.c_str());
     const std::string stats = io::JsonObject()
                                   .add("input", input)
@@ -74,6 +100,7 @@ struct MonitorCommand {
                                   .add("violations", run.violations)
                                   .str();
     std::fprintf(stderr, "%s\n", stats.c_str());
+    if (results) results->finish(run.outcome, "end of bag", stats);
     return run.outcome.exit_code();
 #else
     (void)properties;
@@ -176,11 +203,14 @@ struct MonitorCommand {
     runtime::VerdictOutputs sets(std::move(set_sinks), true);
     runtime::SetCallback on_set;
     if (sets.size()) on_set = [&](std::string_view json, double) { sets.put_payload(json); };
+    attach_results("", popts, verdicts);
     runtime::SyncedPipeline pipeline(properties, popts, named, sync.options(named),
                                      [&](const engine::Verdict& v) { verdicts.put(v); }, on_set);
+    start_results(uris, properties);
     runtime::LoopOptions lopts = loop_options(files != 0);
     lopts.input_names = names;
     lopts.input = SyncFlags::joined_names(named);
+    record_counters(lopts);
     runtime::MonitorLoop loop(pipeline, verdicts, stats_sink.get(), lopts);
     SyncFlags::Sources sources = SyncFlags::open_sources(named, per_input);
     install_stop_signals();
@@ -194,7 +224,7 @@ struct MonitorCommand {
       std::fprintf(stderr, "rvc: error: %s\n", e.what());
       outcome.runtime_failure = true;
     }
-    return outcome.exit_code();
+    return finish_results(outcome, loop);
   }
 
   runtime::LoopOptions loop_options(bool from_file) const {
@@ -213,6 +243,7 @@ struct MonitorCommand {
   }
 
   int run() {
+    if (!store.take_database(outputs)) return kUsage;
     if (outputs.empty()) outputs.push_back("-");
     if (SyncFlags::named(inputs)) return run_synced();
     const bool bag = transport::scheme_of(inputs.at(0)) == "mcap";
@@ -243,16 +274,19 @@ struct MonitorCommand {
       return kUsage;
     }
     popts.type = typed.resolve(input_transports);
+    attach_results(input, popts, verdicts);
     runtime::Pipeline pipeline(properties, popts, [&](const engine::Verdict& v) { verdicts.put(v); });
+    start_results({input}, properties);
 
     runtime::LoopOptions lopts = loop_options(transport::scheme_of(input) == "file");
+    record_counters(lopts);
     runtime::MonitorLoop loop(pipeline, verdicts, stats_sink.get(), lopts);
 
     auto source = transport::open_source(input, input_transports);
     install_stop_signals();
     std::fprintf(stderr, "rvc monitor: %zu propert%s on %s -> %zu output%s\n", properties.size(),
                  properties.size() == 1 ? "y" : "ies", input.c_str(), verdicts.size(), verdicts.size() == 1 ? "" : "s");
-    return loop.run(*source).exit_code();
+    return finish_results(loop.run(*source), loop);
   }
 };
 
@@ -268,8 +302,11 @@ Runner register_monitor(CLI::App& app) {
                       "Endpoint to monitor: zenoh:KEYEXPR, dds:TOPIC, file:PATH, - or mcap:BAG (a ROS 2 bag); "
                       "several as NAME=URI (repeatable), synchronized by --sync, tested as {NAME.field}")
           ->required();
-  sub->add_option("--output,-o", cmd->outputs, "Where verdicts go (repeatable): zenoh:KEY, dds:TOPIC, file:PATH, - (default)")
+  sub->add_option("--output,-o", cmd->outputs,
+                  "Where verdicts go (repeatable): zenoh:KEY, dds:TOPIC, file:PATH, - (default); also a results "
+                  "database: sqlite:PATH or postgresql://... (docs/results.md)")
       ->allow_extra_args(false);
+  cmd->store.add_to(*sub);
   sub->add_flag("--exit-on-eos", cmd->exit_on_eos,
                 "Exit after the publisher's end-of-stream marker (ending any other way is then exit 6)");
   sub->add_option("--publishers", cmd->publishers,

@@ -27,5 +27,6 @@ Runner register_bridge(CLI::App& app);
 Runner register_msg(CLI::App& app);         // ROS 2 message types, CDR <-> JSON
 Runner register_echo(CLI::App& app);        // print an endpoint's messages as JSON lines
 Runner register_sync(CLI::App& app);        // several topics -> one stream of sets
+Runner register_dashboard(CLI::App& app);   // web page over a results database
 
 }  // namespace rvc::cli

@@ -7,6 +7,7 @@
 #include <map>
 
 #include "cli/commands.hpp"
+#include "cli/store_options.hpp"
 #include "msg/msg_types.hpp"
 #include "io/properties_file.hpp"
 #include "spec/spec_error.hpp"
@@ -29,6 +30,7 @@ void keep_freed_memory() {
 
 int main(int argc, char** argv) {
   using namespace rvc::cli;
+  set_command_line(argc, argv);
   CLI::App app{"rvc: runtime verification of pub/sub traffic against past-time temporal logic (Rye syntax)"};
   app.set_version_flag("--version", std::string("rvc ") + RVC_VERSION);
   app.require_subcommand(1);
@@ -42,6 +44,7 @@ int main(int argc, char** argv) {
   runners["msg"] = register_msg(app);
   runners["echo"] = register_echo(app);
   runners["sync"] = register_sync(app);
+  runners["dashboard"] = register_dashboard(app);
 #ifdef RVC_HAVE_ZENOH
   runners["router"] = register_router(app);
 #endif
@@ -68,6 +71,9 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "rvc: %s\n", e.what());
     return kUsage;
   } catch (const CLI::Error& e) {
+    std::fprintf(stderr, "rvc: %s\n", e.what());
+    return kUsage;
+  } catch (const rvc::store::DbError& e) {  // a results database that cannot be opened: nothing ran
     std::fprintf(stderr, "rvc: %s\n", e.what());
     return kUsage;
   } catch (const std::invalid_argument& e) {

@@ -99,7 +99,7 @@ class ChunkProcessor {
             resume = at;
             break;
           }
-          ReadResult r = handler_.on_object(Position(buf, at, first_line, &cache_at_, &cache_line_), object);
+          ReadResult r = handler_.on_object(Position(buf, at, fast_len, first_line, &cache_at_, &cache_line_), object);
           if (r == ReadResult::Malformed) {
             resume = at;
             break;
@@ -199,6 +199,17 @@ uint64_t Position::number() const {
   return *cache_line_;
 }
 
+std::string_view Position::text() const {
+  if (!base_) return text_;
+  const char* at = base_ + offset_;
+  const char* end = base_ + end_;
+  while (at < end && (*at == ' ' || *at == '\t' || *at == '\r' || *at == '\n')) ++at;
+  const void* nl = std::memchr(at, '\n', static_cast<size_t>(end - at));
+  const char* stop = nl ? static_cast<const char*>(nl) : end;
+  if (stop > at && stop[-1] == '\r') --stop;
+  return std::string_view(at, static_cast<size_t>(stop - at));
+}
+
 void parse_one(simdjson::ondemand::parser& parser, std::string_view text, uint64_t line, JsonlHandler& handler,
                std::string& scratch) {
   if (text.substr(0, kUtf8Bom.size()) == kUtf8Bom) {
@@ -241,7 +252,7 @@ void parse_one(simdjson::ondemand::parser& parser, std::string_view text, uint64
     fail("invalid JSON", err);
     return;
   }
-  ReadResult r = handler.on_object(Position(line), object);
+  ReadResult r = handler.on_object(Position(line, text), object);
   if (r == ReadResult::Malformed) {
     handler.on_error(LineError{line, 0, handler.json_error()});
     return;

@@ -17,6 +17,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <string_view>
 
 namespace rvc::io {
 
@@ -30,15 +31,21 @@ struct LineError {
 // number given by the transport (a sequence number).
 class Position {
  public:
-  explicit Position(uint64_t number) : number_(number) {}
-  Position(const char* base, size_t offset, uint64_t first_line, const char** cache_at, uint64_t* cache_line)
-      : number_(first_line), base_(base), offset_(offset), cache_at_(cache_at), cache_line_(cache_line) {}
+  explicit Position(uint64_t number, std::string_view text = {}) : number_(number), text_(text) {}
+  Position(const char* base, size_t offset, size_t end, uint64_t first_line, const char** cache_at,
+           uint64_t* cache_line)
+      : number_(first_line), base_(base), offset_(offset), end_(end), cache_at_(cache_at), cache_line_(cache_line) {}
   uint64_t number() const;
+  // The message's own text (its line, without the line break), for a
+  // witness window; valid while the reader's chunk is (until commit()).
+  std::string_view text() const;
 
  private:
   uint64_t number_;
+  std::string_view text_;
   const char* base_ = nullptr;
   size_t offset_ = 0;
+  size_t end_ = 0;  // of the chunk's text: a line may lack its final newline
   const char** cache_at_ = nullptr;  // last position counted in this chunk
   uint64_t* cache_line_ = nullptr;
 };

@@ -122,7 +122,7 @@ void MonitorLoop::process(const std::vector<transport::Source*>& sources) {
 
   using clock = std::chrono::steady_clock;
   const auto idle_limit = std::chrono::duration<double>(options_.idle_timeout);
-  auto last_message = clock::now(), last_stats = clock::now();
+  auto last_message = clock::now(), last_stats = clock::now(), last_record = clock::now();
   std::vector<transport::OwnedFrame> batch;
   size_t count = 0;
   for (;;) {
@@ -179,6 +179,10 @@ void MonitorLoop::process(const std::vector<transport::Source*>& sources) {
       last_stats = now;
       publish_stats();
     }
+    if (options_.on_record && now - last_record > std::chrono::duration<double>(options_.record_interval)) {
+      last_record = now;
+      options_.on_record(stats_json());
+    }
     if (eos_ && options_.exit_on_eos) {
       end_ = EndReason::EndOfStream;
       break;
@@ -199,7 +203,8 @@ Outcome MonitorLoop::run(const std::vector<transport::Source*>& sources) {
     outcome.runtime_failure = true;
   }
   feed_.finish_report();
-  std::string final_stats = stats_json();  // done_at: last verdict out
+  final_stats_ = stats_json();  // done_at: last verdict out
+  const std::string& final_stats = final_stats_;
   std::fprintf(stderr, "%s\n", final_stats.c_str());
   if (stats_sink_) {
     try {

@@ -38,6 +38,10 @@ struct LoopOptions {
   // Frames carry a publisher's sequence numbers (loss accounting). A file's
   // frames carry line numbers instead: blank lines are not lost messages.
   bool sequence_numbers = true;
+  // The counters (JSON) every `record_interval` seconds and once at the end,
+  // for the results store (apart from stats_interval, which prints them).
+  std::function<void(const std::string&)> on_record;
+  double record_interval = 1;
   std::function<bool()> stop_requested = [] { return false; };   // e.g. SIGINT/SIGTERM seen
   std::function<bool()> stats_requested = [] { return false; };  // e.g. SIGUSR1 seen (true once)
 };
@@ -63,6 +67,8 @@ class MonitorLoop {
   std::string stats_json() const;
   const transport::SeqCounters& counters(size_t input = 0) const { return counters_[input]; }
   EndReason end_reason() const { return end_; }
+  // The counters printed at the end of run().
+  const std::string& final_stats() const { return final_stats_; }
 
  private:
   void publish_stats();
@@ -78,6 +84,7 @@ class MonitorLoop {
   std::vector<bool> input_eos_ = std::vector<bool>(1);
   bool eos_ = false;
   EndReason end_ = EndReason::SourceClosed;
+  std::string final_stats_;
   double first_at_ = 0;  // wall clock of the first message (benchmarks compare across processes)
 };
 

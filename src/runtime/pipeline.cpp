@@ -104,6 +104,7 @@ io::ReadResult Pipeline::on_object(const io::Position& where, simdjson::ondemand
   }
   pending_ = true;
   pending_where_.emplace(where);
+  if (options_.on_message) pending_text_ = where.text();
   return io::ReadResult::Pending;
 }
 
@@ -119,6 +120,7 @@ void Pipeline::commit() {
     ++stats_.warnings;
     report("warning: " + options_.position_name + " " + std::to_string(pending_where_->number()) + ": " + w);
   }
+  if (options_.on_message) options_.on_message(options_.input_name, pending_text_, pending_where_->number());
   if (hook_) {
     const bool timed = options_.model == engine::TimeModel::Dense;
     const double t = timed ? message_time() : std::numeric_limits<double>::quiet_NaN();
@@ -187,6 +189,7 @@ void Pipeline::feed_typed(std::string_view sample, uint64_t position) {
   }
   pending_ = true;
   pending_where_.emplace(position);
+  pending_text_ = sample;
   commit();
 }
 

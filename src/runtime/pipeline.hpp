@@ -35,6 +35,11 @@ struct PipelineOptions {
   // decoded straight into the tests' values (properties are checked against
   // the type first). Owned by the caller's msg::TypeRegistry; null: JSON.
   const msg::MessageType* type = nullptr;
+  // Sees each message as it is committed, before the monitors step on it
+  // (the results store's witness window): the input's name, the message's
+  // text (a JSON line, or a CDR sample) and its position.
+  std::function<void(std::string_view input, std::string_view text, uint64_t position)> on_message;
+  std::string input_name;  // what on_message calls this input
 };
 
 // Decode-only mode (a synchronized input, see SyncedPipeline): each accepted
@@ -103,6 +108,7 @@ class Pipeline final : public io::JsonlHandler, public Feed {
   uint64_t reported_ = 0;
   std::vector<std::string> warnings_;  // of the pending message, reported at commit()
   std::string pending_rejection_;      // why the pending message is refused, reported at commit()
+  std::string_view pending_text_;      // its text, when options_.on_message wants it
   std::string json_error_;
   simdjson::ondemand::parser parser_;
   std::string scratch_;

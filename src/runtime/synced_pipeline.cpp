@@ -147,6 +147,7 @@ SyncedPipeline::SyncedPipeline(const std::vector<engine::PropertySpec>& properti
     po.time_field = in.arrival_stamp ? "time" : stamp;
     po.type = in.spec.type;
     po.position_name = "input " + in.spec.name + " " + options.position_name;
+    po.input_name = in.spec.name;
     if (in.spec.type) bind_message_type(*in.atoms, properties, *in.spec.type, dense, po.time_field, in.spec.name);
     const auto input = static_cast<uint32_t>(k);
     in.pipeline = std::make_unique<Pipeline>(

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -26,6 +27,10 @@ class VerdictOutputs {
     type_ = type;
     typed_ = std::move(typed_sinks);
   }
+
+  // Also hands every verdict to `observer` (the results store, the
+  // enforcer), before the sinks, in the engine thread.
+  void observe(std::function<void(const engine::Verdict&)> observer) { observers_.push_back(std::move(observer)); }
 
   // Publishes one verdict on every sink. Throws (std::runtime_error) if a
   // sink cannot take it: verdicts that cannot be delivered end the run.
@@ -49,6 +54,7 @@ class VerdictOutputs {
   std::string line_, sample_;
   const msg::MessageType* type_ = nullptr;
   std::vector<bool> typed_;
+  std::vector<std::function<void(const engine::Verdict&)>> observers_;
 };
 
 }  // namespace rvc::runtime

@@ -1,0 +1,58 @@
+// A results database: SQLite (embedded, the default) or PostgreSQL (fleets).
+// The store writes rows through this interface on its writer thread; the
+// dashboard reads through query(). Both databases hold the same schema
+// (schema.hpp), so the dashboard serves either.
+#pragma once
+
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "store/row.hpp"
+
+namespace rvc::store {
+
+// A database error. `connection_lost`: the server went away (worth retrying
+// after reconnect()); otherwise the statement itself failed.
+class DbError : public std::runtime_error {
+ public:
+  DbError(const std::string& what, bool connection_lost = false)
+      : std::runtime_error(what), connection_lost_(connection_lost) {}
+  bool connection_lost() const { return connection_lost_; }
+
+ private:
+  bool connection_lost_;
+};
+
+// Rows of a query: every value as text, "" for NULL.
+using QueryResult = std::vector<std::vector<std::string>>;
+
+class Database {
+ public:
+  virtual ~Database() = default;
+  // Creates the tables and indexes if missing. Throws DbError.
+  virtual void ensure_schema() = 0;
+  // Writes all rows in one transaction: all or nothing. Throws DbError.
+  virtual void write(const std::vector<Row>& rows) = 0;
+  // After a lost connection: true once connected again (schema ensured).
+  virtual bool reconnect() = 0;
+  // A read-only query; '?' placeholders take `params` in order (the
+  // PostgreSQL backend numbers them). Throws DbError.
+  virtual QueryResult query(const std::string& sql, const std::vector<std::string>& params = {}) = 0;
+  // What to show users: "sqlite:results.db", "postgresql://host/db" (no password).
+  virtual std::string describe() const = 0;
+};
+
+// True for the URIs open_database() takes: sqlite:PATH, postgresql://...,
+// postgres://... (libpq's connection URIs).
+bool is_database_uri(const std::string& uri);
+// Opens (and for SQLite creates) the database. Throws DbError: a bad URI, a
+// server that cannot be reached, a file that cannot be opened.
+std::unique_ptr<Database> open_database(const std::string& uri);
+
+// The backends (open_database picks one by scheme).
+std::unique_ptr<Database> open_sqlite(const std::string& path);
+std::unique_ptr<Database> open_postgres(const std::string& conninfo);
+
+}  // namespace rvc::store

@@ -1,0 +1,10 @@
+// Built without libpq: a postgresql:// output is a clear error, not a crash.
+#include "store/database.hpp"
+
+namespace rvc::store {
+
+std::unique_ptr<Database> open_postgres(const std::string& conninfo) {
+  throw DbError("this rvc was built without PostgreSQL (install libpq-dev and rebuild)");
+}
+
+}  // namespace rvc::store
