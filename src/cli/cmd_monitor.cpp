@@ -18,6 +18,7 @@
 #include "cli/sync_options.hpp"
 #include "cli/type_options.hpp"
 #include "msg/type_registry.hpp"
+#include "runtime/enforcer.hpp"
 #include "runtime/monitor_loop.hpp"
 #include "runtime/synced_pipeline.hpp"
 #ifdef RVC_HAVE_MCAP
@@ -50,6 +51,61 @@ struct MonitorCommand {
   TypeOptions typed;                   // --type: payloads are CDR samples of this ROS 2 type
   std::vector<std::string> topics;     // --topic: of an mcap: input
   StoreFlags store;                    // a results database among the outputs
+  std::vector<std::string> on_violation;  // --on-violation PROPERTY=URI:PAYLOAD
+  double debounce = 0;
+  std::string command_type;            // --command-type: typed commands
+  std::unique_ptr<runtime::Enforcer> enforcer;
+
+  // The enforcer's endpoints, opened with the outputs (and waited for like them).
+  int open_enforcer(const std::vector<engine::PropertySpec>& properties, runtime::VerdictOutputs& verdicts) {
+    if (on_violation.empty()) return 0;
+    std::vector<runtime::EnforceAction> actions;
+    for (const auto& text : on_violation) {
+      actions.push_back(runtime::parse_enforce_action(text));
+      bool known = false;
+      for (const auto& p : properties) known = known || p.name == actions.back().property;
+      if (!known) {
+        std::string names;
+        for (const auto& p : properties) names += (names.empty() ? "" : ", ") + p.name;
+        std::fprintf(stderr, "rvc: --on-violation %s: no property of that name (the properties: %s)\n",
+                     actions.back().property.c_str(), names.c_str());
+        return kUsage;
+      }
+    }
+    const msg::MessageType* type = nullptr;
+    transport::TransportOptions command_transports = transports;
+    if (!command_type.empty()) {
+      for (const auto& p : typed.msg_paths) typed.registry.add_search_path(p);
+      type = &typed.registry.resolve(command_type);
+#ifdef RVC_HAVE_DDS
+      command_transports.dds.ros_type = type;
+#endif
+    }
+    enforcer = std::make_unique<runtime::Enforcer>(std::move(actions), command_transports, debounce, type);
+    std::string which;
+    if (wait_subscribers > 0 &&
+        !enforcer->wait_subscribers(wait_subscribers, std::chrono::milliseconds(static_cast<long>(wait_timeout * 1000)),
+                                    which)) {
+      std::fprintf(stderr, "rvc: no subscriber matched on %s within %.1f s (--wait-timeout)\n", which.c_str(),
+                   wait_timeout);
+      return kIncomplete;
+    }
+    verdicts.observe([this](const engine::Verdict& v) { enforcer->on_verdict(v); });
+    return 0;
+  }
+  int finish_enforcer(int status) {
+    if (!enforcer) return status;
+    try {
+      enforcer->finish();
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "rvc: error: %s\n", e.what());
+      if (status == kOk) status = kRuntime;
+    }
+    std::fprintf(stderr, "rvc monitor: %llu command%s sent on violation (%llu debounced)\n",
+                 static_cast<unsigned long long>(enforcer->commands()), enforcer->commands() == 1 ? "" : "s",
+                 static_cast<unsigned long long>(enforcer->debounced()));
+    return status;
+  }
   std::unique_ptr<runtime::ResultsOutput> results;
 
   // Records the run in the results database (if one is given) and hooks it
@@ -68,7 +124,7 @@ struct MonitorCommand {
   }
   int finish_results(runtime::Outcome outcome, const runtime::MonitorLoop& loop) {
     if (results) results->finish(outcome, runtime::to_string(loop.end_reason()), loop.final_stats());
-    return outcome.exit_code();
+    return finish_enforcer(outcome.exit_code());
   }
 
   // A ROS 2 bag: played through the runtime at once, its topic's type from
@@ -101,7 +157,7 @@ struct MonitorCommand {
                                   .str();
     std::fprintf(stderr, "%s\n", stats.c_str());
     if (results) results->finish(run.outcome, "end of bag", stats);
-    return run.outcome.exit_code();
+    return finish_enforcer(run.outcome.exit_code());
 #else
     (void)properties;
     (void)popts;
@@ -191,6 +247,7 @@ struct MonitorCommand {
     std::vector<std::unique_ptr<transport::Sink>> sinks;
     if (int status = open_outputs(sinks, stats_sink)) return status;
     runtime::VerdictOutputs verdicts = make_verdicts(std::move(sinks));
+    if (int status = open_enforcer(properties, verdicts)) return status;
     runtime::PipelineOptions popts = check.pipeline_options();
     popts.position_name = files ? "line" : "seq";
     // --sets-output: what the properties saw, for `rvc check` to replay.
@@ -259,6 +316,7 @@ struct MonitorCommand {
     std::vector<std::unique_ptr<transport::Sink>> sinks;
     if (int status = open_outputs(sinks, stats_sink)) return status;
     runtime::VerdictOutputs verdicts = make_verdicts(std::move(sinks));
+    if (int status = open_enforcer(properties, verdicts)) return status;
     runtime::PipelineOptions popts = check.pipeline_options();
     popts.position_name = "seq";
     if (transport::scheme_of(input) == "mcap") return run_bag(properties, popts, verdicts);
@@ -307,6 +365,16 @@ Runner register_monitor(CLI::App& app) {
                   "database: sqlite:PATH or postgresql://... (docs/results.md)")
       ->allow_extra_args(false);
   cmd->store.add_to(*sub);
+  sub->add_option("--on-violation", cmd->on_violation,
+                  "Enforcer (repeatable): when PROPERTY becomes violated, publish PAYLOAD on URI, e.g. "
+                  "p1=zenoh:vehicle/hazard:{\"on\":true} (docs/enforcer.md)");
+  sub->add_option("--debounce", cmd->debounce,
+                  "Enforcer: at least S seconds between two commands of one --on-violation")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  sub->add_option("--command-type", cmd->command_type,
+                  "Enforcer: send commands on dds:/zenoh: as CDR samples of this type (their PAYLOAD is its JSON), e.g. "
+                  "std_msgs/msg/Bool");
   sub->add_flag("--exit-on-eos", cmd->exit_on_eos,
                 "Exit after the publisher's end-of-stream marker (ending any other way is then exit 6)");
   sub->add_option("--publishers", cmd->publishers,

@@ -41,6 +41,18 @@ std::string json_number(const std::string& text) {
   return out;
 }
 
+// Wall-clock seconds: fixed microseconds (the shortest form of 1795458121.04142
+// would be scientific).
+std::string json_wall(const std::string& text) {
+  if (text.empty()) return "null";
+  char* end = nullptr;
+  const double v = std::strtod(text.c_str(), &end);
+  if (end == text.c_str()) return "null";
+  std::string out;
+  io::append_fixed(out, v, 6);
+  return out;
+}
+
 std::string json_text_or_null(const std::string& text) {
   if (text.empty()) return "null";
   std::string out;
@@ -62,12 +74,6 @@ std::string embedded_json(const std::string& text) {
   simdjson::dom::element element;
   if (parser.parse(text.data(), text.size()).get(element) == simdjson::SUCCESS) return simdjson::minify(element);
   return json_text_or_null(text);
-}
-
-std::string quoted(std::string_view s) {
-  std::string out;
-  io::append_json_string(out, s);
-  return out;
 }
 
 // --- query parameters -------------------------------------------------------
@@ -132,14 +138,14 @@ io::JsonObject run_object(const Row& r) {
       .add("command", r[1])
       .add_raw("inputs", embedded_json(r[2]))
       .add("time_model", r[3])
-      .add_raw("started_at", json_number(r[4]))
-      .add_raw("ended_at", json_number(r[5]))
+      .add_raw("started_at", json_wall(r[4]))
+      .add_raw("ended_at", json_wall(r[5]))
       .add_raw("exit_status", json_number(r[6]))
       .add_raw("end_reason", json_text_or_null(r[7]))
       .add_raw("final_counters", embedded_json(r[8]))
       .add_raw("violations", json_number(r[9]))
       .add_raw("property_count", json_number(r[10]))
-      .add_raw("last_counters_at", json_number(r[11]))
+      .add_raw("last_counters_at", json_wall(r[11]))
       // No end recorded yet: the monitor is running (or died without one;
       // the page shows how long it has been silent from last_counters_at).
       .add("live", r[5].empty());
@@ -212,7 +218,7 @@ io::JsonObject verdict_object(const Row& v) {  // id, property, time, value, wal
       .add("property", v[1])
       .add_raw("time", json_number(v[2]))
       .add_raw("value", json_bool_or_null(v[3]))
-      .add_raw("wall", json_number(v[4]));
+      .add_raw("wall", json_wall(v[4]));
 }
 
 io::JsonObject violation_object(const Row& v) {  // id, property, time, wall, witness
@@ -220,7 +226,7 @@ io::JsonObject violation_object(const Row& v) {  // id, property, time, wall, wi
       .add_raw("id", json_number(v[0]))
       .add("property", v[1])
       .add_raw("time", json_number(v[2]))
-      .add_raw("wall", json_number(v[3]))
+      .add_raw("wall", json_wall(v[3]))
       .add_raw("witness", embedded_json(v[4]));
 }
 
@@ -320,7 +326,7 @@ std::string counters_array(Database& db, const std::string& run, const QueryResu
   for (const Row& r : rows) {
     const Snapshot s = read_snapshot(r);
     io::JsonObject o;
-    o.add_raw("id", json_number(r[0])).add_raw("wall", json_number(r[1])).add_raw("counters", embedded_json(r[2]));
+    o.add_raw("id", json_number(r[0])).add_raw("wall", json_wall(r[1])).add_raw("counters", embedded_json(r[2]));
     auto prev = previous.find(s.input);
     const double dt = prev == previous.end() ? NAN : s.wall - prev->second.wall;
     if (dt > 0) {  // NaN compares false: no rate without an earlier snapshot
