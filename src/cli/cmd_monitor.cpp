@@ -19,6 +19,8 @@
 #include "cli/type_options.hpp"
 #include "msg/type_registry.hpp"
 #include "runtime/enforcer.hpp"
+#include "runtime/forwarder.hpp"
+#include "runtime/message_filter.hpp"
 #include "runtime/monitor_loop.hpp"
 #include "runtime/synced_pipeline.hpp"
 #ifdef RVC_HAVE_MCAP
@@ -55,6 +57,32 @@ struct MonitorCommand {
   double debounce = 0;
   std::string command_type;            // --command-type: typed commands
   std::unique_ptr<runtime::Enforcer> enforcer;
+  runtime::FilterOptions filter_options;  // --allow/--deny/--project
+  std::unique_ptr<runtime::MessageFilter> filter;
+  std::string forward_property;           // --forward: ROSMonitoring's filter action
+  std::string forward_to;
+
+  // The filter in front of the monitor, keyed per input by its topic or key.
+  void set_filter(runtime::LoopOptions& lopts, const std::vector<std::string>& uris) {
+    filter = std::make_unique<runtime::MessageFilter>(filter_options);
+    if (!filter->active()) return;
+    lopts.filter = filter.get();
+    for (const auto& uri : uris) {
+      const size_t colon = uri.find(':');
+      lopts.key_of_input.push_back(colon == std::string::npos ? uri : uri.substr(colon + 1));
+    }
+  }
+
+  static int check_property_name(const std::string& name, const std::vector<engine::PropertySpec>& properties,
+                                 const char* flag) {
+    for (const auto& p : properties)
+      if (p.name == name) return 0;
+    std::string names;
+    for (const auto& p : properties) names += (names.empty() ? "" : ", ") + p.name;
+    std::fprintf(stderr, "rvc: %s %s: no property of that name (the properties: %s)\n", flag, name.c_str(),
+                 names.c_str());
+    return kUsage;
+  }
 
   // The enforcer's endpoints, opened with the outputs (and waited for like them).
   int open_enforcer(const std::vector<engine::PropertySpec>& properties, runtime::VerdictOutputs& verdicts) {
@@ -62,15 +90,7 @@ struct MonitorCommand {
     std::vector<runtime::EnforceAction> actions;
     for (const auto& text : on_violation) {
       actions.push_back(runtime::parse_enforce_action(text));
-      bool known = false;
-      for (const auto& p : properties) known = known || p.name == actions.back().property;
-      if (!known) {
-        std::string names;
-        for (const auto& p : properties) names += (names.empty() ? "" : ", ") + p.name;
-        std::fprintf(stderr, "rvc: --on-violation %s: no property of that name (the properties: %s)\n",
-                     actions.back().property.c_str(), names.c_str());
-        return kUsage;
-      }
+      if (int status = check_property_name(actions.back().property, properties, "--on-violation")) return status;
     }
     const msg::MessageType* type = nullptr;
     transport::TransportOptions command_transports = transports;
@@ -243,6 +263,10 @@ struct MonitorCommand {
       return kUsage;
     }
     if (refuse_own_inputs(uris)) return kUsage;
+    if (!forward_property.empty()) {
+      std::fprintf(stderr, "rvc: --forward republishes the messages of one input; several inputs are checked as sets\n");
+      return kUsage;
+    }
     std::unique_ptr<transport::Sink> stats_sink;
     std::vector<std::unique_ptr<transport::Sink>> sinks;
     if (int status = open_outputs(sinks, stats_sink)) return status;
@@ -268,6 +292,7 @@ struct MonitorCommand {
     lopts.input_names = names;
     lopts.input = SyncFlags::joined_names(named);
     record_counters(lopts);
+    set_filter(lopts, uris);
     runtime::MonitorLoop loop(pipeline, verdicts, stats_sink.get(), lopts);
     SyncFlags::Sources sources = SyncFlags::open_sources(named, per_input);
     install_stop_signals();
@@ -338,13 +363,35 @@ struct MonitorCommand {
 
     runtime::LoopOptions lopts = loop_options(transport::scheme_of(input) == "file");
     record_counters(lopts);
-    runtime::MonitorLoop loop(pipeline, verdicts, stats_sink.get(), lopts);
+    set_filter(lopts, {input});
+    // --forward: what passes the property goes on to <input>_mon.
+    std::unique_ptr<runtime::Forwarder> forwarder;
+    if (!forward_property.empty()) {
+      if (int status = check_property_name(forward_property, properties, "--forward")) return status;
+      const std::string to = forward_to.empty() ? runtime::monitored_topic(input) : forward_to;
+      if (refuse_own_input(to, input)) return kUsage;
+      forwarder = std::make_unique<runtime::Forwarder>(pipeline, forward_property,
+                                                       transport::open_sink(to, input_transports), verdicts);
+      std::fprintf(stderr, "rvc monitor: messages that keep %s true go on to %s\n", forward_property.c_str(),
+                   to.c_str());
+    }
+    runtime::Feed& feed = forwarder ? static_cast<runtime::Feed&>(*forwarder) : pipeline;
+    runtime::MonitorLoop loop(feed, verdicts, stats_sink.get(), lopts);
 
     auto source = transport::open_source(input, input_transports);
     install_stop_signals();
     std::fprintf(stderr, "rvc monitor: %zu propert%s on %s -> %zu output%s\n", properties.size(),
                  properties.size() == 1 ? "y" : "ies", input.c_str(), verdicts.size(), verdicts.size() == 1 ? "" : "s");
-    return finish_results(loop.run(*source), loop);
+    runtime::Outcome outcome = loop.run(*source);
+    if (forwarder) {
+      try {
+        forwarder->finish();
+      } catch (const std::exception& e) {
+        std::fprintf(stderr, "rvc: error: %s\n", e.what());
+        outcome.runtime_failure = true;
+      }
+    }
+    return finish_results(outcome, loop);
   }
 };
 
@@ -365,6 +412,19 @@ Runner register_monitor(CLI::App& app) {
                   "database: sqlite:PATH or postgresql://... (docs/results.md)")
       ->allow_extra_args(false);
   cmd->store.add_to(*sub);
+  sub->add_option("--allow", cmd->filter_options.allow,
+                  "Filter (repeatable): only messages whose key (a zenoh: sample's own key) or topic matches one of "
+                  "these patterns reach the monitor; '*' one chunk, '**' any chunks (docs/filter.md)");
+  sub->add_option("--deny", cmd->filter_options.deny,
+                  "Filter (repeatable): messages whose key or topic matches are kept from the monitor (wins over --allow)");
+  sub->add_option("--project", cmd->filter_options.project,
+                  "Filter (repeatable): keep only these fields of each JSON message (dotted paths) for the monitor, "
+                  "the witness window and --forward")
+      ->delimiter(',');
+  sub->add_option("--forward", cmd->forward_property,
+                  "ROSMonitoring's filter: republish each message after which PROPERTY still holds on <input>_mon "
+                  "(or --forward-to); violating messages are held back");
+  sub->add_option("--forward-to", cmd->forward_to, "Where --forward republishes (default: the input URI + _mon)");
   sub->add_option("--on-violation", cmd->on_violation,
                   "Enforcer (repeatable): when PROPERTY becomes violated, publish PAYLOAD on URI, e.g. "
                   "p1=zenoh:vehicle/hazard:{\"on\":true} (docs/enforcer.md)");

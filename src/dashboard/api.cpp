@@ -332,8 +332,8 @@ std::string counters_array(Database& db, const std::string& run, const QueryResu
     if (dt > 0) {  // NaN compares false: no rate without an earlier snapshot
       o.add("rates", io::JsonObject()
                          .add_fixed("seconds", dt, 3)
-                         .add("received_per_s", (s.received - prev->second.received) / dt)
-                         .add("checked_per_s", (s.checked - prev->second.checked) / dt));
+                         .add_fixed("received_per_s", (s.received - prev->second.received) / dt, 3)
+                         .add_fixed("checked_per_s", (s.checked - prev->second.checked) / dt, 3));
     } else {
       o.add_raw("rates", "null");
     }

@@ -95,6 +95,7 @@ std::string MonitorLoop::stats_json() const {
     }
     out.add_raw("inputs", inputs.str());
   }
+  if (options_.filter) out.add("filtered", filtered_);
   feed_.add_stats(out);
   return out.add_fixed("first_at", first_at_, 6).add_fixed("done_at", wall_now(), 6).str();
 }
@@ -170,6 +171,15 @@ void MonitorLoop::process(const std::vector<transport::Source*>& sources) {
           if (payload.find_first_not_of(" \t\r") == std::string_view::npos) continue;
         }
         if (!options_.sequence_numbers) ++counters.received;
+        if (options_.filter) {  // after loss accounting: a filtered message was not lost
+          std::string_view key = f.key;
+          if (key.empty() && f.input < options_.key_of_input.size()) key = options_.key_of_input[f.input];
+          if (!options_.filter->admits(key)) {
+            ++filtered_;
+            continue;
+          }
+          if (options_.filter->projecting() && options_.filter->project(payload, projected_)) payload = projected_;
+        }
         feed_.feed_input(f.input, payload, f.seq ? f.seq : counters.received);
       }
     }

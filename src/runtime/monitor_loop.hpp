@@ -17,6 +17,7 @@
 
 #include "runtime/exit_status.hpp"
 #include "runtime/feed.hpp"
+#include "runtime/message_filter.hpp"
 #include "runtime/verdict_outputs.hpp"
 #include "transport/endpoint.hpp"
 #include "transport/seq_counter.hpp"
@@ -38,6 +39,10 @@ struct LoopOptions {
   // Frames carry a publisher's sequence numbers (loss accounting). A file's
   // frames carry line numbers instead: blank lines are not lost messages.
   bool sequence_numbers = true;
+  // In front of the monitor (--allow/--deny/--project; may be null): a frame
+  // is filtered by its own key (Zenoh) or else by its input's key_of_input.
+  MessageFilter* filter = nullptr;
+  std::vector<std::string> key_of_input;
   // The counters (JSON) every `record_interval` seconds and once at the end,
   // for the results store (apart from stats_interval, which prints them).
   std::function<void(const std::string&)> on_record;
@@ -85,6 +90,8 @@ class MonitorLoop {
   bool eos_ = false;
   EndReason end_ = EndReason::SourceClosed;
   std::string final_stats_;
+  uint64_t filtered_ = 0;   // messages the filter kept from the monitor
+  std::string projected_;   // the message as the filter projected it
   double first_at_ = 0;  // wall clock of the first message (benchmarks compare across processes)
 };
 

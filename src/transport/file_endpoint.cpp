@@ -36,7 +36,12 @@ void FileSource::read_all(const FrameHandler& handler) {
     // Blank lines (nothing, or only spaces, tabs and CRs) are not messages,
     // as in `rvc check`.
     std::string_view text(buf.data() + begin, len);
-    if (text.find_first_not_of(" \t\r") != std::string_view::npos) handler(Frame{text, line, false});
+    if (text.find_first_not_of(" \t\r") != std::string_view::npos) {
+      Frame f;
+      f.payload = text;
+      f.seq = line;
+      handler(f);
+    }
   };
   char chunk[1 << 16];
   for (;;) {
@@ -64,7 +69,12 @@ void FileSource::read_all(const FrameHandler& handler) {
     scanned = buf.size();
   }
   if (!buf.empty()) deliver(0, buf.size());  // a last line without its newline
-  if (!stop_.load()) handler(Frame{{}, line, true});
+  if (!stop_.load()) {
+    Frame eos;
+    eos.seq = line;
+    eos.eos = true;
+    handler(eos);
+  }
 }
 
 void FileSource::stop() {

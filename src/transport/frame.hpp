@@ -14,6 +14,7 @@ struct Frame {
   bool eos = false;          // end-of-stream marker: payload is empty, seq = last data seq
   uint64_t publisher = 0;    // who sent it (DDS publication handle, rvc's Zenoh publisher id); 0 if unknown
   uint32_t input = 0;        // which input of several (set by the monitor loop, not by transports)
+  std::string_view key;      // the sample's own key (Zenoh: a wildcard subscriber sees many); empty if none
 };
 
 // Called on a transport thread. Must copy what it keeps and return quickly.

@@ -24,6 +24,7 @@ struct OwnedFrame {
   bool eos = false;
   uint64_t publisher = 0;
   uint32_t input = 0;
+  std::string key;
 };
 
 class FrameQueue {
@@ -42,6 +43,7 @@ class FrameQueue {
     slot.eos = frame.eos;
     slot.publisher = frame.publisher;
     slot.input = frame.input;
+    slot.key.assign(frame.key.data(), frame.key.size());
     if (incoming_count_ == 1) not_empty_.notify_one();
   }
 

@@ -511,6 +511,8 @@ pub type rvc_zenoh_sample_cb = unsafe extern "C" fn(
     len: usize,
     attachment: *const u8,
     att_len: usize,
+    key: *const u8,
+    key_len: usize,
     ctx: *mut c_void,
 );
 
@@ -541,8 +543,11 @@ impl CallbackTarget {
             Some(a) => (a.as_ptr(), a.len()),
             None => (std::ptr::null(), 0),
         };
+        // The sample's own key (a subscriber on a wildcard sees many): lets
+        // rvc filter by key before the monitor.
+        let key = sample.key_expr().as_str();
         // SAFETY: pointers stay valid for the duration of the call.
-        unsafe { (self.cb)(payload.as_ptr(), payload.len(), ap, al, self.ctx) };
+        unsafe { (self.cb)(payload.as_ptr(), payload.len(), ap, al, key.as_ptr(), key.len(), self.ctx) };
     }
 }
 

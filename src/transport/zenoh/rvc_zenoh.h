@@ -85,11 +85,13 @@ int rvc_zenoh_session_close(rvc_zenoh_session* s);
 /* ---- subscriber ------------------------------------------------------- */
 
 /* Called on a Zenoh thread for each put sample (deletes are ignored).
- * payload/attachment are borrowed for the call only; attachment is NULL with
- * att_len 0 when the sample has none. Zero-copy unless the payload arrived
+ * payload/attachment/key are borrowed for the call only; attachment is NULL
+ * with att_len 0 when the sample has none; key is the sample's own key
+ * expression (not NUL-terminated). Zero-copy unless the payload arrived
  * fragmented. Must return quickly and must not throw. */
 typedef void (*rvc_zenoh_sample_cb)(const uint8_t* payload, size_t len,
-                                    const uint8_t* attachment, size_t att_len, void* ctx);
+                                    const uint8_t* attachment, size_t att_len,
+                                    const uint8_t* key, size_t key_len, void* ctx);
 
 /* announce != 0 also declares the liveliness token
  * "rvc/subscribers/<unique id>/<keyexpr>" so publishers can count rvc

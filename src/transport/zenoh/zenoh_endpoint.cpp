@@ -31,6 +31,7 @@ void ZenohSource::start(FrameHandler handler) {
     f.eos = a.eos;
     f.publisher = a.publisher;
     if (!a.eos) f.payload = s.payload;  // an EOS marker carries no data
+    f.key = s.key;
     std::lock_guard lock(*mu);
     handler(f);
   };

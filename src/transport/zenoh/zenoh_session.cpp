@@ -114,11 +114,12 @@ struct ZenohSubscriber::State {
   ZenohSampleCallback callback;
   std::atomic<uint64_t> errors{0};
 
-  static void trampoline(const uint8_t* payload, size_t len, const uint8_t* att, size_t att_len,
-                         void* ctx) noexcept {
+  static void trampoline(const uint8_t* payload, size_t len, const uint8_t* att, size_t att_len, const uint8_t* key,
+                         size_t key_len, void* ctx) noexcept {
     auto* st = static_cast<State*>(ctx);
     ZenohSample sample;
     sample.payload = std::string_view(reinterpret_cast<const char*>(payload), len);
+    sample.key = std::string_view(reinterpret_cast<const char*>(key), key_len);
     sample.has_attachment = att != nullptr;
     if (att) sample.attachment = std::string_view(reinterpret_cast<const char*>(att), att_len);
     // An exception must not unwind into Rust; count it, tell once.

@@ -63,6 +63,7 @@ struct ZenohSample {
   std::string_view payload;     // borrowed for the callback only
   std::string_view attachment;  // empty when none
   bool has_attachment = false;
+  std::string_view key;         // the sample's key expression, borrowed likewise
 };
 using ZenohSampleCallback = std::function<void(const ZenohSample&)>;
 
