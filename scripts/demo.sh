@@ -5,7 +5,12 @@
 #   rvc replay trace.jsonl --to zenoh:rv/timescales   (publisher)
 #   rvc monitor --input zenoh:rv/timescales --output zenoh:rv/verdicts --output file:verdicts.jsonl
 # then the same trace through `rvc check`, to show the verdicts are identical.
+# The monitor also keeps its results in SQLite (build/demo/results.db: runs,
+# verdict changes, violations with their witness windows, counters);
+# `scripts/demo.sh --dashboard` then serves them on http://127.0.0.1:8765.
 set -euo pipefail
+DASHBOARD=0
+[ "${1:-}" = "--dashboard" ] && DASHBOARD=1
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
 bash scripts/build.sh
@@ -33,7 +38,8 @@ if "$RVC" router --help >/dev/null 2>&1; then
   echo
   echo "== rvc monitor over Zenoh (peer-to-peer on tcp/127.0.0.1:$PORT, multicast scouting off)"
   "$RVC" monitor --properties "$OUT/properties.yaml" --input zenoh:rv/timescales \
-    --output zenoh:rv/verdicts --output "file:$OUT/verdicts.jsonl" --exit-on-eos "${ZENOH_MON[@]}" \
+    --output zenoh:rv/verdicts --output "file:$OUT/verdicts.jsonl" --output "sqlite:$OUT/results.db" \
+    --exit-on-eos "${ZENOH_MON[@]}" \
     2> "$OUT/monitor.log" &
   MON=$!
   trap 'kill $MON 2>/dev/null || true' EXIT
@@ -47,7 +53,8 @@ if "$RVC" router --help >/dev/null 2>&1; then
 else
   echo "(rvc was built without Zenoh: checking the file locally instead)"
   set +e
-  "$RVC" check --properties "$OUT/properties.yaml" "$OUT/trace.jsonl" -o "$OUT/verdicts.jsonl"
+  "$RVC" check --properties "$OUT/properties.yaml" "$OUT/trace.jsonl" -o "$OUT/verdicts.jsonl" \
+    -o "sqlite:$OUT/results.db"
   status=$?
   set -e
 fi
@@ -64,4 +71,9 @@ else
   exit 1
 fi
 echo "exit status $status (0: all properties held, 1: a property was violated, 4: messages lost)"
-[ "$status" -le 1 ]
+echo "== results in SQLite: $OUT/results.db (see them: $RVC dashboard --db sqlite:$OUT/results.db, or scripts/demo.sh --dashboard)"
+[ "$status" -le 1 ] || exit 1
+if [ "$DASHBOARD" = 1 ]; then
+  echo "== rvc dashboard on http://127.0.0.1:8765 (Ctrl-C to stop)"
+  exec "$RVC" dashboard --db "sqlite:$OUT/results.db" --listen 127.0.0.1:8765
+fi

@@ -10,7 +10,9 @@ if [ "$(id -u)" != 0 ]; then SUDO="sudo"; fi
 APT_PACKAGES=(
   build-essential cmake ninja-build pkg-config git
   libsimdjson-dev libcli11-dev libyaml-cpp-dev libgtest-dev libgmock-dev libbenchmark-dev
-  libsqlite3-dev
+  libsqlite3-dev libpq-dev postgresql  # results store: SQLite embedded, PostgreSQL (tests start their own server)
+  libcpp-httplib-dev                    # rvc dashboard's HTTP server
+  chromium                              # the dashboard's browser tests (Playwright drives it)
   cyclonedds-dev cyclonedds-tools
   python3 python3-pip
   iproute2 time
@@ -58,4 +60,17 @@ then
   "$PY" -m pip install -q "${PIP_PACKAGES[@]}" 2>/dev/null ||
     "$PY" -m pip install -q --break-system-packages "${PIP_PACKAGES[@]}"
 fi
+# The dashboard's browser tests: Playwright's core library from npm (tests/browser/package-lock.json),
+# driving Debian's Chromium; node and npm from Debian when the machine has none.
+if ! command -v node >/dev/null 2>&1 || ! command -v npm >/dev/null 2>&1; then
+  echo "install-deps: apt packages: nodejs npm"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends nodejs npm >/dev/null
+fi
+BROWSER_DIR="$(cd "$(dirname "$0")/.." && pwd)/tests/browser"
+if [ -f "$BROWSER_DIR/package-lock.json" ] && [ ! -d "$BROWSER_DIR/node_modules/playwright-core" ]; then
+  echo "install-deps: npm ci (tests/browser: playwright-core)"
+  (cd "$BROWSER_DIR" && npm ci --no-audit --no-fund --loglevel=error)
+fi
+
 echo "install-deps: ok"

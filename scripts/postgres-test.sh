@@ -72,7 +72,7 @@ init_cluster() {
       die "the postgres user cannot reach $dir: a parent directory is not searchable by it (use a directory under /tmp, not one inside a 0700 directory)"
   fi
   say "initialising $data"
-  as_server "$PG_BIN/initdb" -D "$data" -U "$DB_USER" --auth=trust --encoding=UTF8 --locale=C.UTF-8 \
+  as_server "$PG_BIN/initdb" -D "$data" -U "$DB_USER" --auth=trust --encoding=UTF8 --locale=C.UTF-8 --no-sync \
     > "$dir/initdb.log" 2>&1 || { cat "$dir/initdb.log" >&2; die "initdb failed (log above)"; }
   # Later lines win in postgresql.conf, so these override the defaults.
   cat >> "$data/postgresql.conf" <<EOF

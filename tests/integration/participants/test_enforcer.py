@@ -127,8 +127,8 @@ def test_one_command_per_onset_over_zenoh(rvc, zenoh_mod):
 
 
 def test_a_first_verdict_false_is_an_onset_and_two_actions_share_a_property(rvc, zenoh_mod):
-    """A trace that starts violated: the first verdict (false) fires; the run of 4 false messages that
-    follows fires nothing more; a later onset (index 6) fires again. Two actions on p1 both fire."""
+    """A trace that starts violated (4 false messages): the first verdict is false and fires, the other
+    3 of that run fire nothing more; a later onset (index 6) fires again. Two actions on p1 both fire."""
     values = [False, False, False, False, True, True, False, False, True]
     rc, err, verdicts, cmds = run_zenoh(
         rvc, zenoh_mod, ["{ok}"], ['p1=zenoh:rvc/enf/a:{"n":1}', 'p1=zenoh:rvc/enf/b:{"n":2}'], values)
