@@ -15,7 +15,7 @@ void set_command_line(int argc, char** argv) {
   std::string& text = command_line_text();
   for (int i = 0; i < argc; ++i) {
     if (i) text += ' ';
-    text += argv[i];
+    text += store::redact_password(argv[i]);  // the command line is stored: no database password in it
   }
 }
 

@@ -59,8 +59,11 @@ bool start_events(store::Database& db, const Params& params, const std::string& 
                   EventCursor& cursor, Response& error);
 
 // One poll: "event: verdict|violation|counters|run" blocks, each with the new
-// rows as a JSON array in `data:` and the cursor as `id:`; "" when nothing is
-// new. Advances `cursor`. Throws store::DbError.
+// rows as a JSON array in `data:` (rows as the endpoints above return them;
+// `run`: the whole runs list, sent when a run starts or ends) and the cursor
+// as `id:`; "" when nothing is new. Advances `cursor`. Throws store::DbError
+// (the server then sends one `event: db-error`, and `db-ok` once polls work
+// again; not `error`, which EventSource keeps for its own connection errors).
 std::string poll_events(store::Database& db, EventCursor& cursor);
 
 }  // namespace rvc::dashboard

@@ -261,6 +261,7 @@ bool DashboardServer::Impl::pump(Stream& s, httplib::DataSink& sink) {
       Lease db(pool);
       out = poll_events(*db, s.cursor);
       db.done();
+      if (s.failing) out = "event: db-ok\ndata: {}\n\n" + out;  // the page clears its warning
       s.failing = false;
     } catch (const store::DbError& e) {
       if (!s.failing) out = "event: db-error\ndata: " + error_response(503, e.what()).body + "\n\n";

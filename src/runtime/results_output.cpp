@@ -7,7 +7,7 @@
 namespace rvc::runtime {
 
 ResultsOutput::ResultsOutput(const std::string& uri, store::StoreOptions options)
-    : store_(std::make_unique<store::ResultsStore>(store::open_database(uri), std::move(options))) {}
+    : store_(std::make_unique<store::ResultsStore>(store::open_database_when_reachable(uri), std::move(options))) {}
 
 void ResultsOutput::attach(const std::string& input_name, PipelineOptions& options, VerdictOutputs& outputs) {
   store::ResultsStore* store = store_.get();

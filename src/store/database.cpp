@@ -1,5 +1,7 @@
 #include "store/database.hpp"
 
+#include <cstdio>
+
 namespace rvc::store {
 
 namespace {
@@ -23,6 +25,76 @@ std::unique_ptr<Database> open_database(const std::string& uri) {
   }
   db->ensure_schema();
   return db;
+}
+
+namespace {
+
+// A server database not reachable yet: connects on the first write or
+// reconnect(), and behaves as the real one from then on.
+class WhenReachable final : public Database {
+ public:
+  explicit WhenReachable(std::string uri) : uri_(std::move(uri)) {}
+  void ensure_schema() override { get().ensure_schema(); }
+  void write(const std::vector<Row>& rows) override { get().write(rows); }
+  bool reconnect() override {
+    if (db_) return db_->reconnect();
+    try {
+      get();
+      return true;
+    } catch (const DbError&) {
+      return false;
+    }
+  }
+  QueryResult query(const std::string& sql, const std::vector<std::string>& params) override {
+    return get().query(sql, params);
+  }
+  std::string describe() const override { return db_ ? db_->describe() : redact_password(uri_); }
+
+ private:
+  Database& get() {
+    if (!db_) {
+      try {
+        db_ = open_database(uri_);
+      } catch (const DbError& e) {
+        throw DbError(e.what(), true);  // not there yet: keep the rows and retry
+      }
+    }
+    return *db_;
+  }
+  std::string uri_;
+  std::unique_ptr<Database> db_;
+};
+
+}  // namespace
+
+std::unique_ptr<Database> open_database_when_reachable(const std::string& uri) {
+  try {
+    return open_database(uri);
+  } catch (const DbError& e) {
+    if (!e.connection_lost() || starts_with(uri, "sqlite:")) throw;
+    std::fprintf(stderr, "rvc: results database: %s; keeping results until it is reachable\n", e.what());
+    return std::make_unique<WhenReachable>(uri);
+  }
+}
+
+std::string redact_password(const std::string& text) {
+  std::string out = text;
+  const size_t scheme = out.find("://");
+  if (scheme != std::string::npos) {
+    const size_t at = out.find('@', scheme + 3);
+    const size_t slash = out.find('/', scheme + 3);
+    if (at != std::string::npos && (slash == std::string::npos || at < slash)) {
+      const size_t colon = out.find(':', scheme + 3);
+      if (colon != std::string::npos && colon < at) out.replace(colon, at - colon, ":***");
+    }
+  }
+  for (size_t at = out.find("password="); at != std::string::npos; at = out.find("password=", at + 1)) {
+    const size_t begin = at + 9;
+    size_t end = out.find_first_of("& ", begin);
+    if (end == std::string::npos) end = out.size();
+    out.replace(begin, end - begin, "***");
+  }
+  return out;
 }
 
 }  // namespace rvc::store

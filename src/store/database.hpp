@@ -13,8 +13,10 @@
 
 namespace rvc::store {
 
-// A database error. `connection_lost`: the server went away (worth retrying
-// after reconnect()); otherwise the statement itself failed.
+// A database error. `connection_lost`: the database is away or busy for now
+// (a server that went away, a SQLite file locked too long, a full disk):
+// worth retrying after reconnect(). Otherwise the rows themselves were
+// refused and retrying them as they are cannot succeed.
 class DbError : public std::runtime_error {
  public:
   DbError(const std::string& what, bool connection_lost = false)
@@ -50,6 +52,15 @@ bool is_database_uri(const std::string& uri);
 // Opens (and for SQLite creates) the database. Throws DbError: a bad URI, a
 // server that cannot be reached, a file that cannot be opened.
 std::unique_ptr<Database> open_database(const std::string& uri);
+// As open_database, but a server that cannot be reached yet is not an error:
+// the database connects on its first write or reconnect() (a monitor that
+// starts before its fleet's database keeps its results until it is there).
+// Still throws for a bad URI or a file that cannot be opened.
+std::unique_ptr<Database> open_database_when_reachable(const std::string& uri);
+
+// `uri` (or any argument) without a password: "postgresql://u:secret@h/db"
+// -> "postgresql://u@h/db", "...?password=secret" -> "...?password=***".
+std::string redact_password(const std::string& text);
 
 // The backends (open_database picks one by scheme).
 std::unique_ptr<Database> open_sqlite(const std::string& path);

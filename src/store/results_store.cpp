@@ -1,9 +1,12 @@
 #include "store/results_store.hpp"
 
+#include <fcntl.h>
 #include <simdjson.h>
+#include <sys/file.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cstdio>
 #include <ctime>
@@ -38,12 +41,37 @@ std::string new_run_id() {
 
 }  // namespace
 
+namespace {
+
+// "rvc-results-<database>.spool": a spool belongs to one database, so rows
+// kept for one are never written into another.
+std::string default_spool(const std::string& description) {
+  const std::string prefix = "sqlite:";
+  if (description.rfind(prefix, 0) == 0) return description.substr(prefix.size()) + ".spool";
+  std::string name = "rvc-results-";
+  for (char c : description.substr(description.find("://") == std::string::npos ? 0 : description.find("://") + 3))
+    name += std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '.' ? c : '_';
+  return name.substr(0, 120) + ".spool";
+}
+
+}  // namespace
+
 ResultsStore::ResultsStore(std::unique_ptr<Database> db, StoreOptions options)
     : db_(std::move(db)), options_(std::move(options)), description_(db_->describe()) {
-  if (options_.spool.empty()) {
-    const std::string prefix = "sqlite:";
-    options_.spool = description_.rfind(prefix, 0) == 0 ? description_.substr(prefix.size()) + ".spool"
-                                                       : "rvc-results.spool";
+  if (options_.spool.empty()) options_.spool = default_spool(description_);
+  // Two processes must not append to, drain and cut the same spool: the
+  // second one on a spool that is taken uses its own.
+  for (int attempt = 0; attempt < 2; ++attempt) {
+    spool_lock_ = ::open((options_.spool + ".lock").c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (spool_lock_ >= 0 && ::flock(spool_lock_, LOCK_EX | LOCK_NB) == 0) break;
+    if (spool_lock_ >= 0) ::close(spool_lock_);
+    spool_lock_ = -1;
+    if (attempt == 0) {
+      const std::string own = options_.spool + "." + std::to_string(::getpid());
+      std::fprintf(stderr, "rvc: results spool %s is in use by another rvc: using %s\n", options_.spool.c_str(),
+                   own.c_str());
+      options_.spool = own;
+    }
   }
   ring_.resize(options_.witness);
   // An earlier run's spool is written before anything of this run.
@@ -53,6 +81,10 @@ ResultsStore::ResultsStore(std::unique_ptr<Database> db, StoreOptions options)
 
 ResultsStore::~ResultsStore() {
   if (!done_) finish(0);
+  if (spool_lock_ >= 0) {
+    ::unlink((options_.spool + ".lock").c_str());
+    ::close(spool_lock_);
+  }
 }
 
 void ResultsStore::push(Row row) {
@@ -184,6 +216,12 @@ bool ResultsStore::write_batch(std::vector<Row>& batch) {
   try {
     db_->write(batch);
   } catch (const DbError& e) {
+    if (!e.connection_lost()) {
+      // The rows themselves were refused (one of them, most likely): retrying
+      // the batch would refuse it forever and hold back everything behind it.
+      write_one_by_one(batch);
+      return connected_;
+    }
     if (connected_)
       std::fprintf(stderr, "rvc: results database %s: %s; keeping results and retrying\n", description_.c_str(),
                    e.what());
@@ -197,6 +235,34 @@ bool ResultsStore::write_batch(std::vector<Row>& batch) {
     stats_.violations += r.table == Table::Violation;
   }
   return true;
+}
+
+void ResultsStore::write_one_by_one(std::vector<Row>& batch) {
+  std::vector<Row> rest;
+  for (size_t i = 0; i < batch.size(); ++i) {
+    try {
+      db_->write({batch[i]});
+      std::lock_guard<std::mutex> lock(mutex_);
+      ++stats_.rows;
+      stats_.verdicts += batch[i].table == Table::Verdict;
+      stats_.violations += batch[i].table == Table::Violation;
+    } catch (const DbError& e) {
+      if (e.connection_lost()) {  // gone in the middle: the rest waits
+        connected_ = false;
+        rest.assign(std::make_move_iterator(batch.begin() + i), std::make_move_iterator(batch.end()));
+        break;
+      }
+      uint64_t refused;
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        refused = ++stats_.refused;
+      }
+      if (refused <= 10)
+        std::fprintf(stderr, "rvc: results database %s refused a %s row of run %s: %s\n", description_.c_str(),
+                     table_name(batch[i].table), batch[i].run.c_str(), e.what());
+    }
+  }
+  batch = std::move(rest);
 }
 
 void ResultsStore::spill(std::vector<Row>& rows) {
@@ -241,9 +307,15 @@ bool ResultsStore::drain_spool() {
     if (!write_batch(batch)) {
       // Keep what is not written yet, and only that: a later drain must not
       // write the committed batches twice.
-      for (size_t i = 0; i < n; ++i) rows[done + i] = std::move(batch[i]);
-      std::ofstream out(options_.spool, std::ios::trunc);
-      for (size_t i = done; i < rows.size(); ++i) out << to_spool_line(rows[i]) << '\n';
+      // (write_batch may have kept only the rows after a lost connection.)
+      const size_t kept_from = done + n - batch.size();
+      for (size_t i = 0; i < batch.size(); ++i) rows[kept_from + i] = std::move(batch[i]);
+      const std::string next = options_.spool + ".next";
+      {
+        std::ofstream out(next, std::ios::trunc);
+        for (size_t i = kept_from; i < rows.size(); ++i) out << to_spool_line(rows[i]) << '\n';
+      }
+      std::rename(next.c_str(), options_.spool.c_str());  // atomic: a crash leaves the old or the new spool
       return false;
     }
     done += n;
@@ -262,8 +334,13 @@ void ResultsStore::writer_loop() {
     Clock::time_point deadline;
     {
       std::unique_lock<std::mutex> lock(mutex_);
-      wake_.wait_for(lock, std::chrono::duration<double>(options_.flush_interval),
-                     [this] { return stopping_ || queue_.size() >= kBatchRows; });
+      // While stopping with the database away there is nothing to do until
+      // the next attempt: wait without the stopping_ predicate (no spinning).
+      if (stopping_ && !connected_)
+        wake_.wait_for(lock, std::chrono::milliseconds(50));
+      else
+        wake_.wait_for(lock, std::chrono::duration<double>(options_.flush_interval),
+                       [this] { return stopping_ || queue_.size() >= kBatchRows; });
       batch.swap(queue_);
       stopping = stopping_;
       deadline = deadline_;

@@ -52,6 +52,7 @@ struct StoreStats {
   uint64_t spooled = 0;      // rows that went through the spool file
   uint64_t reconnects = 0;   // times the database came back
   uint64_t left_in_spool = 0;  // rows still in the spool at the end (database never came back)
+  uint64_t refused = 0;      // rows the database refused as they are (reported one by one)
 };
 
 class ResultsStore {
@@ -92,6 +93,7 @@ class ResultsStore {
   std::string witness_json() const;
   void writer_loop();
   bool write_batch(std::vector<Row>& batch);  // writer thread; false: database away
+  void write_one_by_one(std::vector<Row>& batch);  // after a refused batch: keep every row it can
   void spill(std::vector<Row>& rows);          // to the spool file
   bool drain_spool();                          // spool -> database; false: database away
   bool finish(double wait_seconds);
@@ -121,6 +123,7 @@ class ResultsStore {
   std::deque<Row> pending_;  // failed to write, in order
   bool spooling_ = false;    // the spool file holds rows older than pending_/queue_
   bool connected_ = true;
+  int spool_lock_ = -1;      // flock on "<spool>.lock": one process per spool file
 };
 
 }  // namespace rvc::store

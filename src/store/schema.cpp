@@ -1,5 +1,7 @@
 #include "store/schema.hpp"
 
+#include <cmath>
+
 #include "io/json_writer.hpp"
 
 namespace rvc::store {
@@ -47,6 +49,9 @@ const char* insert_statement(Table table) {
 namespace {
 // Shortest text that reads back to the same double (also what verdict lines use).
 std::string num(double v) {
+  // PostgreSQL reads these spellings for double precision (JSON's null would be refused).
+  if (std::isnan(v)) return "NaN";
+  if (std::isinf(v)) return v > 0 ? "Infinity" : "-Infinity";
   std::string out;
   io::append_number(out, v);
   return out;

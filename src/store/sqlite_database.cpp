@@ -99,15 +99,21 @@ class SqliteDatabase final : public Database {
       case Table::RunEnd: text(r.text[0]), text(r.text[1]), real(r.number[1]), integer(r.integer), text(r.run); break;
     }
   }
+  // Busy, locked, I/O and full-disk errors pass (another process holds the
+  // file, space is freed): the store keeps the rows and tries again.
   DbError error(const std::string& what) const {
-    return DbError(describe() + ": " + what + ": " + sqlite3_errmsg(db_));
+    const int code = sqlite3_errcode(db_) & 0xff;
+    const bool transient = code == SQLITE_BUSY || code == SQLITE_LOCKED || code == SQLITE_IOERR ||
+                           code == SQLITE_FULL || code == SQLITE_CANTOPEN || code == SQLITE_READONLY;
+    return DbError(describe() + ": " + what + ": " + sqlite3_errmsg(db_), transient);
   }
   void exec(const std::string& sql) {
     char* message = nullptr;
     if (sqlite3_exec(db_, sql.c_str(), nullptr, nullptr, &message) != SQLITE_OK) {
       std::string what = message ? message : "unknown error";
       sqlite3_free(message);
-      throw DbError(describe() + ": " + what + " (in: " + sql + ")");
+      DbError e = error("");
+      throw DbError(describe() + ": " + what + " (in: " + sql + ")", e.connection_lost());
     }
   }
   sqlite3_stmt* insert(Table table) {

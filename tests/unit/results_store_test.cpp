@@ -33,6 +33,8 @@ struct FlakyDb : Database {
       ++s->failed_writes;
       throw DbError("server closed the connection", true);
     }
+    for (const Row& r : rows)
+      if (r.text[0] == "refused") throw DbError("invalid input syntax", false);  // the whole batch rolls back
     std::lock_guard<std::mutex> lock(s->mutex);
     s->rows.insert(s->rows.end(), rows.begin(), rows.end());
   }
@@ -161,6 +163,30 @@ TEST(ResultsStore, TheSpoolOutlivesTheRun) {
   EXPECT_EQ(shared->rows[0].text[0], "first");
   EXPECT_EQ(shared->rows[5].text[0], "second");
   EXPECT_FALSE(std::filesystem::exists(spool));
+}
+
+// A row the database refuses as it is costs only itself: the rest of its
+// batch, and everything after it, is written.
+TEST(ResultsStore, ARefusedRowCostsOnlyItself) {
+  auto shared = std::make_shared<FlakyDb::Shared>();
+  ResultsStore store(std::make_unique<FlakyDb>(shared), fast_options(temp_path("f.spool")));
+  store.begin_run({"rvc check", {"in"}, "discrete", {{"p1", "{a}"}, {"refused", "{b}"}}});
+  store.on_verdict("p1", 0, true);
+  store.on_verdict("refused", 0, true);
+  store.on_verdict("p1", 1, false);
+  ASSERT_TRUE(store.end_run(1, "end of input", "{}"));
+  EXPECT_EQ(store.stats().refused, 2u);  // the property row and the verdict row
+  std::vector<std::string> got = summary(shared->rows);
+  EXPECT_EQ(got, (std::vector<std::string>{"run", "property", "verdict p1@0=1", "verdict p1@1=0",
+                                           "violation p1@1 []", "run_end"}));
+}
+
+TEST(ResultsStore, PasswordsAreRedacted) {
+  EXPECT_EQ(redact_password("postgresql://rv:s3cret@db.local:5432/rvc"), "postgresql://rv:***@db.local:5432/rvc");
+  EXPECT_EQ(redact_password("postgresql:///rvc?host=/tmp/x&password=s3cret&user=u"),
+            "postgresql:///rvc?host=/tmp/x&password=***&user=u");
+  EXPECT_EQ(redact_password("postgresql://rv@db/rvc"), "postgresql://rv@db/rvc");
+  EXPECT_EQ(redact_password("--spec"), "--spec");
 }
 
 TEST(ResultsStore, SpoolLinesRoundTrip) {
