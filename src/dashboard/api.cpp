@@ -31,23 +31,25 @@ constexpr int64_t kCountersDefault = 100, kCountersMax = 10000;
 
 // Every value arrives as text ("" for NULL). Numbers are re-printed by the
 // project's writer, so they come out in one form whatever the database.
-std::string json_number(const std::string& text) {
-  if (text.empty()) return "null";
+bool parse_number(const std::string& text, double& v) {
   char* end = nullptr;
-  const double v = std::strtod(text.c_str(), &end);
-  if (end == text.c_str()) return "null";
+  v = std::strtod(text.c_str(), &end);
+  return !text.empty() && end != text.c_str();
+}
+
+std::string json_number(const std::string& text) {
+  double v;
+  if (!parse_number(text, v)) return "null";
   std::string out;
   io::append_number(out, v);
   return out;
 }
 
-// Wall-clock seconds: fixed microseconds (the shortest form of 1795458121.04142
-// would be scientific).
+// Wall-clock seconds: fixed, to the microsecond (the shortest form of
+// 1795458121.04142 would be scientific).
 std::string json_wall(const std::string& text) {
-  if (text.empty()) return "null";
-  char* end = nullptr;
-  const double v = std::strtod(text.c_str(), &end);
-  if (end == text.c_str()) return "null";
+  double v;
+  if (!parse_number(text, v)) return "null";
   std::string out;
   io::append_fixed(out, v, 6);
   return out;
@@ -314,9 +316,10 @@ Snapshot read_snapshot(const Row& row) {  // id, wall, counters
 std::string counters_array(Database& db, const std::string& run, const QueryResult& rows) {
   std::map<std::string, Snapshot> previous;
   if (!rows.empty()) {
-    QueryResult older = db.query(std::string("SELECT ") + kCounterColumns +
-                                     " FROM counters WHERE run = ? AND id < CAST(? AS BIGINT) ORDER BY id DESC LIMIT 64",
-                                 {run, rows.front()[0]});
+    // The 64 snapshots before: one per input for any run with up to 64 inputs.
+    const std::string sql = std::string("SELECT ") + kCounterColumns +
+                            " FROM counters WHERE run = ? AND id < CAST(? AS BIGINT) ORDER BY id DESC LIMIT 64";
+    QueryResult older = db.query(sql, {run, rows.front()[0]});
     for (auto it = older.rbegin(); it != older.rend(); ++it) {
       Snapshot s = read_snapshot(*it);
       previous[s.input] = s;

@@ -3,6 +3,7 @@
 #include <arpa/inet.h>
 #include <httplib.h>
 #include <strings.h>
+#include <sys/socket.h>
 #include <sys/stat.h>
 
 #include <atomic>
@@ -185,7 +186,8 @@ void DashboardServer::Impl::routes() {
   // requests addressed to a loopback name.
   http.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
     const std::string host = host_of(req.get_header_value("Host"));
-    if (options.allow_remote || host.empty() || is_loopback_host(host)) return httplib::Server::HandlerResponse::Unhandled;
+    if (options.allow_remote || host.empty() || is_loopback_host(host))
+      return httplib::Server::HandlerResponse::Unhandled;
     reply(res, error_response(403, "Host '" + host + "' is not a loopback name (see --allow-remote)"));
     return httplib::Server::HandlerResponse::Handled;
   });
@@ -198,6 +200,14 @@ void DashboardServer::Impl::routes() {
   });
   http.Get("/api/events", [this](const httplib::Request& req, httplib::Response& res) { serve_events(req, res); });
   http.Get(R"(/api/.*)", [this](const httplib::Request& req, httplib::Response& res) { serve_api(req, res); });
+  // httplib's default also sets SO_REUSEPORT: a second dashboard (or any
+  // process of this user) could then bind the same port and take part of the
+  // traffic. SO_REUSEADDR alone still allows a restart while old connections
+  // linger in TIME_WAIT.
+  http.set_socket_options([](socket_t sock) {
+    int yes = 1;
+    ::setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
+  });
   // Event streams hold a thread each for as long as they last; the pool is
   // sized so that the page and API calls still find threads.
   const size_t threads = static_cast<size_t>(options.max_streams) + 8;

@@ -20,7 +20,7 @@ import { chromium } from 'playwright-core';
 
 const here = path.dirname(fileURLToPath(import.meta.url));
 const root = path.resolve(here, '..', '..');
-const RVC = process.env.RVC_BIN || path.join(root, 'build', 'release', 'rvc');
+const RVC = path.resolve(process.env.RVC_BIN || path.join(root, 'build', 'release', 'rvc'));
 const SCREENSHOTS = process.env.RVC_SCREENSHOTS === '1';
 
 // --- the database ------------------------------------------------------------
@@ -111,33 +111,47 @@ function buildDatabase(db) {
 }
 
 // --- the server and the browser ----------------------------------------------
-let dir, db, server, port, browser, page;
+let dir, db, server, port, browser, context, page;
 const foreign = [];  // requests to anything but the dashboard
+
+// `rvc dashboard` on port 0; resolves to [process, port] once it says where it serves.
+function startDashboard(dbPath) {
+  // From the database's directory, so the page shows sqlite:results.db as a user would type it.
+  const proc = spawn(RVC, ['dashboard', '--db', `sqlite:${path.basename(dbPath)}`, '--listen', '127.0.0.1:0', '--poll', '0.1'],
+                     { cwd: path.dirname(dbPath), stdio: ['ignore', 'ignore', 'pipe'] });
+  return new Promise((resolve, reject) => {
+    let err = '';
+    const timer = setTimeout(() => reject(new Error('rvc dashboard did not start: ' + err)), 15000);
+    proc.stderr.on('data', (d) => {
+      err += d;
+      const m = err.match(/serving \S+ on http:\/\/127\.0\.0\.1:(\d+)/);
+      if (m) { clearTimeout(timer); resolve([proc, Number(m[1])]); }
+    });
+    proc.on('exit', (code) => reject(new Error(`rvc dashboard exited (${code}): ${err}`)));
+  });
+}
+// SIGTERM with an event stream open must still be a clean stop (exit 0).
+async function stopDashboard(proc) {
+  if (proc.exitCode !== null) return proc.exitCode;
+  const exited = new Promise((resolve) => proc.on('exit', resolve));
+  proc.kill('SIGTERM');
+  return exited;
+}
 
 before(async () => {
   dir = mkdtempSync(path.join(tmpdir(), 'rvc-dashboard-'));
   db = path.join(dir, 'results.db');
   buildDatabase(db);
-  server = spawn(RVC, ['dashboard', '--db', `sqlite:${db}`, '--listen', '127.0.0.1:0', '--poll', '0.1'], { stdio: ['ignore', 'ignore', 'pipe'] });
-  port = await new Promise((resolve, reject) => {
-    let err = '';
-    const timer = setTimeout(() => reject(new Error('rvc dashboard did not start: ' + err)), 15000);
-    server.stderr.on('data', (d) => {
-      err += d;
-      const m = err.match(/serving \S+ on http:\/\/127\.0\.0\.1:(\d+)/);
-      if (m) { clearTimeout(timer); resolve(Number(m[1])); }
-    });
-    server.on('exit', (code) => reject(new Error(`rvc dashboard exited (${code}): ${err}`)));
-  });
+  [server, port] = await startDashboard(db);
   browser = await chromium.launch({
     executablePath: '/usr/bin/chromium',
     args: ['--no-sandbox', '--no-proxy-server', '--host-resolver-rules=MAP * ~NOTFOUND, EXCLUDE 127.0.0.1',
            '--disable-background-networking', '--disable-component-update', '--disable-sync', '--no-first-run'],
   });
-  const context = await browser.newContext({ viewport: { width: 1280, height: 800 } });
+  context = await browser.newContext({ viewport: { width: 1280, height: 800 } });
   await context.route('**/*', (route) => {
     const url = new URL(route.request().url());
-    if (url.hostname === '127.0.0.1' && Number(url.port) === port) return route.continue();
+    if (url.hostname === '127.0.0.1' && /^\d+$/.test(url.port)) return route.continue();  // the dashboards
     foreign.push(url.href);
     return route.abort();
   });
@@ -148,13 +162,10 @@ before(async () => {
 });
 
 after(async () => {
+  const code = server ? await stopDashboard(server) : 0;  // before the browser: its stream is still open
   if (browser) await browser.close();
-  if (server && server.exitCode === null) {
-    const exited = new Promise((resolve) => server.on('exit', resolve));
-    server.kill('SIGTERM');
-    assert.equal(await exited, 0);  // SIGTERM with a stream open: a clean stop
-  }
   if (dir) rmSync(dir, { recursive: true, force: true });
+  assert.equal(code, 0);
 });
 
 const row = (name) => page.locator(`#properties [data-property="${name}"]`);
@@ -248,6 +259,26 @@ test('choosing another run shows its properties and violations', async () => {
   assert.equal(await page.locator('#violations .witness-line').count(), 5);
   assert.match(await page.locator('#run-info').innerText(), /fault-hazard-late\.jsonl/);
   assert.match(page.url(), new RegExp(`#run=${HAZARD_LATE}$`));
+});
+
+test('an empty database: the first run appears and opens by itself', async () => {
+  const empty = path.join(dir, 'empty.db');
+  sql(empty, SCHEMA);
+  const [proc, emptyPort] = await startDashboard(empty);
+  const p2 = await context.newPage();
+  try {
+    await p2.goto(`http://127.0.0.1:${emptyPort}/`);
+    await p2.waitForSelector('#status[data-state="live"]');
+    assert.match(await p2.locator('#runs').innerText(), /No runs yet/);
+    sql(empty, [['INSERT INTO runs (run, command, inputs, time_model, started_at) VALUES (?,?,?,?,?)', ['r-first', 'rvc monitor', '[]', 'discrete', Date.now() / 1000]],
+                ['INSERT INTO properties VALUES (?,?,?)', ['r-first', 'speed_limit', SPECS.speed_limit]],
+                verdict('r-first', 'speed_limit', 0, true, Date.now() / 1000)]);
+    await p2.waitForSelector('#run[data-run="r-first"]', { timeout: 5000 });
+    assert.equal(await p2.locator('#properties [data-property="speed_limit"]').getAttribute('data-value'), 'true');
+  } finally {
+    await p2.close();
+    assert.equal(await stopDashboard(proc), 0);
+  }
 });
 
 test('the page loaded nothing from anywhere else', () => {

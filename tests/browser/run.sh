@@ -13,7 +13,7 @@
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 
-in_ci() { case "$(echo "${CI:-}" | tr '[:upper:]' '[:lower:]')" in 1|true|yes) return 0 ;; esac; return 1; }
+in_ci() { local ci="${CI:-}"; case "${ci,,}" in 1|true|yes) return 0 ;; esac; return 1; }
 missing() {
   if in_ci; then
     echo "browser.dashboard: FAILED: $1 (CI=true: a missing dependency is a failure; scripts/install-deps.sh installs it)" >&2
@@ -29,8 +29,9 @@ command -v npm >/dev/null || missing "npm is not installed (apt-get install npm)
 [ -x /usr/bin/chromium ] || missing "Debian's Chromium is not at /usr/bin/chromium (apt-get install chromium)"
 command -v python3 >/dev/null || missing "python3 is not installed (the test writes its database with sqlite3)"
 
-export RVC_BIN="${RVC_BIN:-$here/../../build/release/rvc}"
+RVC_BIN="${RVC_BIN:-$here/../../build/release/rvc}"
 [ -x "$RVC_BIN" ] || { echo "browser.dashboard: no rvc binary at $RVC_BIN (build first or set RVC_BIN)" >&2; exit 2; }
+export RVC_BIN="$(cd "$(dirname "$RVC_BIN")" && pwd)/$(basename "$RVC_BIN")"  # absolute: the test runs from here
 
 if [ ! -d "$here/node_modules/playwright-core" ]; then
   # Exactly the locked version; its install script downloads nothing.
