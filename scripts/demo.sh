@@ -49,7 +49,8 @@ if "$RVC" router --help >/dev/null 2>&1; then
   status=$?
   set -e
   trap - EXIT
-  echo "monitor counters: $(tail -n 1 "$OUT/monitor.log")"
+  echo "monitor counters: $(grep '^{' "$OUT/monitor.log" | tail -n 1)"
+  grep "^rvc: results in" "$OUT/monitor.log" || true
 else
   echo "(rvc was built without Zenoh: checking the file locally instead)"
   set +e
