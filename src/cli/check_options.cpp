@@ -9,6 +9,9 @@ void CheckOptions::add_to(CLI::App& app) {
   app.add_option("--properties,-p", properties_file, "YAML/JSON file of named properties")->check(CLI::ExistingFile);
   app.add_flag("--dense", dense, "Dense time: messages carry a time field; values hold until the next message");
   app.add_flag("--all", all, "Report the verdict at every step, not only changes");
+  app.add_flag("--robustness", robustness,
+               "Report robustness values (Reelay's quantitative semantics: how far from changing the verdict; "
+               "positive holds) instead of true/false; discrete time, JSON input (docs/semantics.md)");
   app.add_flag("--strict", strict, "Reject messages missing a field a property tests, or with wrong types");
   app.add_option("--time-field", time_field,
                  "Field holding the time in dense time: a path (header.stamp) to seconds or a Time {sec, nanosec} "
@@ -45,6 +48,7 @@ PipelineOptions CheckOptions::pipeline_options() const {
   o.time_field = time_field;
   o.max_reported = max_reported;
   o.parse_only = parse_only;
+  o.robustness = robustness;
   o.max_message_size = max_message_size;
   return o;
 }

@@ -1,5 +1,6 @@
 #include "engine/checker.hpp"
 
+#include <limits>
 #include <stdexcept>
 
 #include "spec/parser.hpp"
@@ -10,11 +11,24 @@ namespace rvc::engine {
 Checker::Checker(TimeModel model, bool emit_all, VerdictCallback on_verdict)
     : model_(model), emit_all_(emit_all), on_verdict_(std::move(on_verdict)) {}
 
+void Checker::enable_robustness() {
+  if (model_ != TimeModel::Discrete)
+    throw std::invalid_argument("--robustness works in discrete time for now (not with --dense)");
+  if (!names_.empty()) throw std::logic_error("enable_robustness after add_property");
+  robustness_ = true;
+}
+
 void Checker::add_property(const PropertySpec& property) {
   spec::ParseOptions options;
   options.dense = model_ == TimeModel::Dense;
   spec::NodePtr ast = spec::parse(property.spec, options);
   Program program = compile(*ast, atoms_, model_, property.spec);
+  if (robustness_) {
+    if (std::string why = robust::Monitor::unsupported(program); !why.empty())
+      throw spec::SpecError(why, property.spec, 1);
+    robust_.emplace_back(program);
+    last_robustness_.push_back(std::numeric_limits<double>::quiet_NaN());
+  }
   try {
     if (model_ == TimeModel::Discrete) discrete_.emplace_back(program);
     else dense_.emplace_back(program);
@@ -36,6 +50,19 @@ void Checker::step(const uint8_t* atoms) {
   for (size_t i = 0; i < discrete_.size(); ++i) {
     double now = static_cast<double>(discrete_[i].now());
     report(i, now, discrete_[i].step(atoms));
+  }
+}
+
+void Checker::step_robust(const double* margins) {
+  const double now = static_cast<double>(now_robust_++);
+  for (size_t i = 0; i < robust_.size(); ++i) {
+    const double r = robust_[i].step(margins);
+    // Condensed as Reelay condenses: a value equal to the last one is no change.
+    if (!emit_all_ && r == last_robustness_[i]) continue;
+    last_robustness_[i] = r;
+    const bool holds = r > 0;  // 0 is not a margin: a false Boolean field is 0
+    if (!holds) ++violations_;
+    if (on_verdict_) on_verdict_(Verdict{names_[i], now, holds, true, r});
   }
 }
 

@@ -15,13 +15,16 @@
 #include "engine/dense/monitor.hpp"
 #include "engine/discrete/monitor.hpp"
 #include "engine/program.hpp"
+#include "engine/robust/monitor.hpp"
 
 namespace rvc::engine {
 
 struct Verdict {
   const std::string& property;
   double time;  // step index in discrete time
-  bool value;
+  bool value;   // with robustness: robustness > 0
+  bool robust = false;    // robustness semantics (--robustness): `robustness` is the verdict
+  double robustness = 0;
 };
 using VerdictCallback = std::function<void(const Verdict&)>;
 
@@ -34,6 +37,11 @@ class Checker {
  public:
   Checker(TimeModel model, bool emit_all, VerdictCallback on_verdict);
 
+  // Robustness (quantitative) semantics instead of Boolean verdicts, in
+  // discrete time: call before add_property; step_robust() then drives it.
+  void enable_robustness();
+  bool robustness() const { return robustness_; }
+
   // Parses and compiles; throws spec::SpecError naming the column.
   void add_property(const PropertySpec& property);
 
@@ -45,6 +53,8 @@ class Checker {
 
   // Discrete time: one step with the atoms' values after the message.
   void step(const uint8_t* atoms);
+  // Robustness, discrete time: one step with the atoms' margins.
+  void step_robust(const double* margins);
   // Dense time: the atoms' values held over [begin, end).
   void step(double begin, double end, const uint8_t* atoms);
 
@@ -60,6 +70,10 @@ class Checker {
   std::vector<std::string> names_;
   std::vector<discrete::Monitor> discrete_;
   std::vector<dense::Monitor> dense_;
+  bool robustness_ = false;
+  std::vector<robust::Monitor> robust_;
+  std::vector<double> last_robustness_;
+  int64_t now_robust_ = 0;
   std::vector<int8_t> last_;  // last reported value per property, -1 before the first
   uint64_t violations_ = 0;
 };

@@ -1,5 +1,8 @@
 #include "io/field_tests.hpp"
 
+#include <cmath>
+#include <limits>
+
 namespace rvc::io {
 
 using FOp = spec::FieldTest::Op;
@@ -61,6 +64,34 @@ int evaluate_test(const spec::FieldTest& t, const FieldValue& v) {
     case FOp::Ge: return number ? v.d >= t.value.number : -1;
   }
   return -1;
+}
+
+double test_margin(const spec::FieldTest& t, const FieldValue& v) {
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  const bool number = v.kind == ValueKind::Number && t.value.kind == spec::Literal::Kind::Number;
+  switch (t.op) {
+    case FOp::Truthy:
+      if (v.kind == ValueKind::Bool) return v.b ? 1 : 0;
+      if (v.kind == ValueKind::Number) return v.d;
+      if (v.kind == ValueKind::Null) return 0;
+      break;
+    case FOp::Lt:
+    case FOp::Le:
+      if (number) return t.value.number - v.d;
+      break;
+    case FOp::Gt:
+    case FOp::Ge:
+      if (number) return v.d - t.value.number;
+      break;
+    case FOp::Eq:
+    case FOp::Ne:
+      if (number) return t.op == FOp::Eq ? -std::fabs(v.d - t.value.number) : std::fabs(v.d - t.value.number);
+      break;
+    default: break;
+  }
+  const int b = evaluate_test(t, v);  // the rest is all or nothing
+  if (b < 0) return std::numeric_limits<double>::quiet_NaN();
+  return b ? inf : -inf;
 }
 
 }  // namespace rvc::io

@@ -25,6 +25,13 @@ struct FieldValue {
 // strict mode). Null reads as false for a truthiness test, as Reelay does.
 int evaluate_test(const spec::FieldTest& test, const FieldValue& value);
 
+// The test's robustness (Reelay's quantitative semantics): {x > c} and
+// {x >= c}: x - c; {x < c}, {x <= c}: c - x; {x == c}: -|x - c|; {x != c}:
+// |x - c|; a Boolean field {p}: 1 or 0; a number {x}: x; string and Boolean
+// equality, presence: +inf or -inf. NaN: a type the test cannot use (as
+// evaluate_test's -1).
+double test_margin(const spec::FieldTest& test, const FieldValue& value);
+
 // "field "speed" is a string, but {speed > 3} needs a number"
 std::string wrong_type_problem(const spec::FieldTest& test, ValueKind kind);
 

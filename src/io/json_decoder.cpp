@@ -1,6 +1,7 @@
 #include "io/json_decoder.hpp"
 
 #include <algorithm>
+#include <limits>
 
 #include <cstring>
 
@@ -116,6 +117,10 @@ simdjson::error_code validate(simdjson::ondemand::value value, int depth = 0) {
 
 JsonDecoder::JsonDecoder(const engine::AtomTable& atoms, DecoderOptions options)
     : atoms_(atoms), options_(std::move(options)), current_(atoms.size(), 0), next_(atoms.size(), 0) {
+  if (options_.robustness) {
+    margin_.assign(atoms.size(), -std::numeric_limits<double>::infinity());
+    next_margin_ = margin_;
+  }
   const auto& tests = atoms_.tests();
   for (size_t id = 0; id < tests.size(); ++id) {
     KeyNode* node = &root_;
@@ -231,6 +236,10 @@ bool JsonDecoder::invalid(std::string& error, simdjson::error_code err, const st
 bool JsonDecoder::decode(simdjson::ondemand::object object, std::string& error, std::vector<std::string>* warnings) {
   std::copy(current_.begin(), current_.end(), next_.begin());  // (memcpy of no atoms: null pointers)
   for (int id : presence_tests_) next_[id] = 0;
+  if (options_.robustness) {
+    std::copy(margin_.begin(), margin_.end(), next_margin_.begin());
+    for (int id : presence_tests_) next_margin_[id] = -std::numeric_limits<double>::infinity();
+  }
   saw_time_ = false;
   malformed_ = false;
   ++generation_;
@@ -297,7 +306,7 @@ bool JsonDecoder::decode_object(simdjson::ondemand::object object, KeyNode& node
 bool JsonDecoder::decode_value(KeyNode& target, simdjson::ondemand::value value, std::string& error,
                                std::vector<std::string>* warnings) {
   target.seen = generation_;
-  if (target.kind != Kind::General && fast_path(target, value)) return true;
+  if (target.kind != Kind::General && !options_.robustness && fast_path(target, value)) return true;
   json_type type;
   if (auto err = value.type().get(type)) {
     return invalid(error, err);
@@ -332,7 +341,10 @@ bool JsonDecoder::decode_value(KeyNode& target, simdjson::ondemand::value value,
     }
     if (!decode_object(inner, target, error, warnings)) return false;
     for (int id : target.tests)
-      if (atoms_.tests()[id].op == FOp::Present) next_[id] = 1;
+      if (atoms_.tests()[id].op == FOp::Present) {
+        next_[id] = 1;
+        if (options_.robustness) next_margin_[id] = std::numeric_limits<double>::infinity();
+      }
     if (target.time_part == 1) {
       if (!saw_sec_) {
         error = "time field \"" + options_.time_field + "\" is an object without \"sec\" (a Time is {sec, nanosec})";
@@ -350,7 +362,10 @@ bool JsonDecoder::decode_value(KeyNode& target, simdjson::ondemand::value value,
     }
     if (!decode_array(elements, target, error, warnings)) return false;
     for (int id : target.tests)
-      if (atoms_.tests()[id].op == FOp::Present) next_[id] = 1;
+      if (atoms_.tests()[id].op == FOp::Present) {
+        next_[id] = 1;
+        if (options_.robustness) next_margin_[id] = std::numeric_limits<double>::infinity();
+      }
     return true;
   }
   if (!target.tests.empty() && !apply_tests(target, value, type, error, warnings)) return false;
@@ -409,6 +424,7 @@ bool JsonDecoder::apply_tests(KeyNode& node, simdjson::ondemand::value value, js
     const int result = evaluate_test(t, v);  // -1: wrong type, the test keeps its previous value
     if (result >= 0) {
       next_[id] = static_cast<uint8_t>(result);
+      if (options_.robustness) next_margin_[id] = test_margin(t, v);
       continue;
     }
     if (type == json_type::null && !options_.strict) continue;  // null: no value, like a missing field

@@ -23,6 +23,7 @@ struct DecoderOptions {
   bool need_time = false;          // dense time: every message must carry a time
   std::string time_field = "time";
   bool strict = false;
+  bool robustness = false;  // also each test's margin (--robustness; general path only)
 };
 
 class JsonDecoder {
@@ -37,9 +38,15 @@ class JsonDecoder {
   // (rather than valid JSON that the properties cannot use).
   bool malformed() const { return malformed_; }
   // Makes the last successful decode current.
-  void commit() { current_.swap(next_); }
+  void commit() {
+    current_.swap(next_);
+    if (options_.robustness) margin_.swap(next_margin_);
+  }
 
   const uint8_t* values() const { return current_.data(); }
+  // With DecoderOptions::robustness: each test's robustness (io::test_margin);
+  // -inf for a field never seen, as Reelay starts.
+  const double* margins() const { return margin_.data(); }
   double time() const { return time_; }
 
  private:
@@ -93,6 +100,7 @@ class JsonDecoder {
   KeyNode root_;
   std::vector<int> presence_tests_;
   std::vector<uint8_t> current_, next_;
+  std::vector<double> margin_, next_margin_;
   double time_ = 0, next_time_ = 0;
   bool saw_time_ = false;
   double time_sec_ = 0, time_nsec_ = 0;  // parts of a Time object

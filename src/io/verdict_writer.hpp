@@ -12,5 +12,8 @@ namespace rvc::io {
 
 // Appends one verdict line (with '\n') to `out`.
 void append_verdict(std::string& out, double time, bool discrete, std::string_view property, bool value);
+// The same with a robustness value: {"time":3,"property":"p1","value":-1.5}
+// (infinities as the strings "inf" and "-inf", as JSON has no number for them).
+void append_robustness(std::string& out, double time, bool discrete, std::string_view property, double value);
 
 }  // namespace rvc::io

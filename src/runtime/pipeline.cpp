@@ -2,6 +2,7 @@
 
 #include <cstdio>
 #include <limits>
+#include <stdexcept>
 
 #include "io/cdr_codec.hpp"
 #include "io/verdict_writer.hpp"
@@ -14,6 +15,11 @@ namespace {
 engine::Checker build(const std::vector<engine::PropertySpec>& properties, const PipelineOptions& options,
                       engine::VerdictCallback on_verdict) {
   engine::Checker checker(options.model, options.emit_all, std::move(on_verdict));
+  if (options.robustness) {
+    if (options.type)
+      throw std::invalid_argument("--robustness reads JSON messages for now (not --type samples)");
+    checker.enable_robustness();
+  }
   for (const auto& p : properties) {
     try {
       checker.add_property(p);
@@ -49,7 +55,7 @@ Pipeline::Pipeline(const std::vector<engine::PropertySpec>& properties, const Pi
       options_(with_defaults(options)),
       atoms_(checker_.atoms()),
       decoder_(atoms_, io::DecoderOptions{options.model == engine::TimeModel::Dense, options.time_field,
-                                          options.strict}),
+                                          options.strict, options.robustness}),
       batch_reader_(*this, options.max_message_size) {
   make_typed_decoder();
 }
@@ -133,6 +139,9 @@ void Pipeline::commit() {
     hook_(values(), t, pending_where_->number());
   } else if (options_.parse_only) {
     commit_values();
+  } else if (checker_.robustness()) {
+    commit_values();
+    checker_.step_robust(decoder_.margins());
   } else if (checker_.model() == engine::TimeModel::Discrete) {
     commit_values();
     checker_.step(values());

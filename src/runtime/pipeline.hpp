@@ -30,6 +30,7 @@ struct PipelineOptions {
   std::string position_name = "line";  // how errors name a message: "line 12", "seq 12"
   size_t max_reported = 100;           // errors and warnings printed before going quiet
   bool parse_only = false;             // decode every message but run no monitor (benchmark floor)
+  bool robustness = false;             // robustness values instead of Booleans (discrete, JSON)
   size_t max_message_size = 1 << 20;   // longest message: a line, a payload, a line inside a batched payload
   // Typed input (--type): each payload is one CDR sample of this type,
   // decoded straight into the tests' values (properties are checked against

@@ -10,7 +10,8 @@ namespace rvc::runtime {
 void VerdictOutputs::put(const engine::Verdict& v) {
   for (auto& observer : observers_) observer(v);
   line_.clear();
-  io::append_verdict(line_, v.time, discrete_, v.property, v.value);
+  if (v.robust) io::append_robustness(line_, v.time, discrete_, v.property, v.robustness);
+  else io::append_verdict(line_, v.time, discrete_, v.property, v.value);
   line_.pop_back();  // one message per verdict: no newline (file sinks add their own)
   put_payload(line_);
 }
