@@ -101,6 +101,8 @@ SyncedPipeline::SyncedPipeline(const std::vector<engine::PropertySpec>& properti
       sync_(sync),
       on_set_(std::move(on_set)) {
   if (inputs.empty()) throw std::invalid_argument("no inputs to synchronize");
+  if (options.robustness)
+    throw std::invalid_argument("--robustness checks one input for now (not several synchronized ones)");
   std::set<std::string> seen;
   for (const auto& i : inputs) {
     if (!is_identifier(i.name))
