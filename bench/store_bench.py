@@ -51,7 +51,8 @@ def main():
     ap.add_argument("--no-docs", action="store_true")
     a = ap.parse_args()
     tmp = tempfile.mkdtemp(prefix="rvc-store-bench-")
-    pg_dir, pg_uri = os.path.join(tmp, "pg"), None
+    # The server runs as the postgres user: its directory must not sit inside our 0700 temp dir.
+    pg_dir, pg_uri = f"/tmp/rvc-store-bench-pg-{os.getpid()}", None
     try:
         ts = os.path.join(tmp, "timescales.jsonl")
         props = os.path.join(tmp, "props.yaml")
@@ -120,6 +121,7 @@ def main():
             subprocess.run(["bash", os.path.join(ROOT, "scripts", "postgres-test.sh"), "stop", pg_dir],
                            capture_output=True)
         shutil.rmtree(tmp, ignore_errors=True)
+        shutil.rmtree(pg_dir, ignore_errors=True)
 
 
 if __name__ == "__main__":
