@@ -12,6 +12,8 @@ void CheckOptions::add_to(CLI::App& app) {
   app.add_flag("--robustness", robustness,
                "Report robustness values (Reelay's quantitative semantics: how far from changing the verdict; "
                "positive holds) instead of true/false; discrete time, JSON input (docs/semantics.md)");
+  app.add_flag("--explain", explain,
+               "With each violation, say why: the sub-formulas and steps that made the verdict false (discrete time)");
   app.add_flag("--strict", strict, "Reject messages missing a field a property tests, or with wrong types");
   app.add_option("--time-field", time_field,
                  "Field holding the time in dense time: a path (header.stamp) to seconds or a Time {sec, nanosec} "
@@ -49,6 +51,7 @@ PipelineOptions CheckOptions::pipeline_options() const {
   o.max_reported = max_reported;
   o.parse_only = parse_only;
   o.robustness = robustness;
+  o.explain = explain;
   o.max_message_size = max_message_size;
   return o;
 }

@@ -24,6 +24,7 @@ struct CheckOptions {
   size_t max_reported = 100;
   bool parse_only = false;
   bool robustness = false;
+  bool explain = false;
 
   void add_to(CLI::App& app);
   // The properties from --spec (named p1, p2, ...) and --properties.

@@ -18,6 +18,11 @@ void Checker::enable_robustness() {
   robustness_ = true;
 }
 
+void Checker::enable_explain() {
+  if (model_ != TimeModel::Discrete) throw std::invalid_argument("--explain works in discrete time for now (not with --dense)");
+  explain_ = true;
+}
+
 void Checker::add_property(const PropertySpec& property) {
   spec::ParseOptions options;
   options.dense = model_ == TimeModel::Dense;
@@ -39,17 +44,23 @@ void Checker::add_property(const PropertySpec& property) {
   last_.push_back(-1);
 }
 
-void Checker::report(size_t property, double time, bool value) {
+void Checker::report(size_t property, double time, bool value, const std::vector<std::string>* explanation) {
   if (!emit_all_ && last_[property] == static_cast<int8_t>(value)) return;
   last_[property] = static_cast<int8_t>(value);
   if (!value) ++violations_;
-  if (on_verdict_) on_verdict_(Verdict{names_[property], time, value});
+  if (on_verdict_) on_verdict_(Verdict{names_[property], time, value, false, 0, explanation});
 }
 
 void Checker::step(const uint8_t* atoms) {
   for (size_t i = 0; i < discrete_.size(); ++i) {
     double now = static_cast<double>(discrete_[i].now());
-    report(i, now, discrete_[i].step(atoms));
+    const bool value = discrete_[i].step(atoms);
+    if (explain_ && !value && last_[i] != 0) {  // a violation starts: say why
+      const std::vector<std::string> why = discrete_[i].explain();
+      report(i, now, value, &why);
+    } else {
+      report(i, now, value);
+    }
   }
 }
 

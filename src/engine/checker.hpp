@@ -25,6 +25,8 @@ struct Verdict {
   bool value;   // with robustness: robustness > 0
   bool robust = false;    // robustness semantics (--robustness): `robustness` is the verdict
   double robustness = 0;
+  // --explain, at the start of a violation: why (Monitor::explain); else null.
+  const std::vector<std::string>* explanation = nullptr;
 };
 using VerdictCallback = std::function<void(const Verdict&)>;
 
@@ -40,6 +42,8 @@ class Checker {
   // Robustness (quantitative) semantics instead of Boolean verdicts, in
   // discrete time: call before add_property; step_robust() then drives it.
   void enable_robustness();
+  // --explain: each violation's verdict carries why (discrete time).
+  void enable_explain();
   bool robustness() const { return robustness_; }
 
   // Parses and compiles; throws spec::SpecError naming the column.
@@ -61,7 +65,7 @@ class Checker {
   uint64_t violations() const { return violations_; }  // verdicts reported false
 
  private:
-  void report(size_t property, double time, bool value);
+  void report(size_t property, double time, bool value, const std::vector<std::string>* explanation = nullptr);
 
   TimeModel model_;
   bool emit_all_;
@@ -71,6 +75,7 @@ class Checker {
   std::vector<discrete::Monitor> discrete_;
   std::vector<dense::Monitor> dense_;
   bool robustness_ = false;
+  bool explain_ = false;
   std::vector<robust::Monitor> robust_;
   std::vector<double> last_robustness_;
   int64_t now_robust_ = 0;

@@ -13,8 +13,9 @@ struct Compiler {
 
   [[noreturn]] void fail(const std::string& message, int column) { throw spec::SpecError(message, source, column); }
 
-  int32_t emit(Instr instr) {
+  int32_t emit(Instr instr, const spec::Node& node) {
     program.code.push_back(instr);
+    program.text.push_back(spec::to_string(node));
     return static_cast<int32_t>(program.code.size() - 1);
   }
 
@@ -23,14 +24,14 @@ struct Compiler {
     Instr in{};
     in.bounds = n.bounds;
     switch (n.op) {
-      case Op::True: in.code = Code::True; return emit(in);
-      case Op::False: in.code = Code::False; return emit(in);
+      case Op::True: in.code = Code::True; return emit(in, n);
+      case Op::False: in.code = Code::False; return emit(in, n);
       case Op::Test:
         if (n.test.op == spec::FieldTest::Op::Bind)
           fail("data references ({key: *var}) are not yet supported by rvc's monitors", n.column);
         in.code = Code::Atom;
         in.atom = atoms.intern(n.test);
-        return emit(in);
+        return emit(in, n);
       case Op::Exists:
       case Op::Forall:
         fail(std::string("'") + spec::op_name(n.op) + "' (data quantifiers) is not yet supported by rvc's monitors",
@@ -51,7 +52,7 @@ struct Compiler {
     }
     in.a = visit(*n.left);
     if (n.right) in.b = visit(*n.right);
-    return emit(in);
+    return emit(in, n);
   }
 };
 

@@ -26,6 +26,7 @@ struct Instr {
 
 struct Program {
   std::vector<Instr> code;
+  std::vector<std::string> text;  // per instruction: its sub-formula in Rye (--explain)
 };
 
 // Compiles a parsed property. Throws spec::SpecError (pointing into `source`)

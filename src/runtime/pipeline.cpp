@@ -20,6 +20,7 @@ engine::Checker build(const std::vector<engine::PropertySpec>& properties, const
       throw std::invalid_argument("--robustness reads JSON messages for now (not --type samples)");
     checker.enable_robustness();
   }
+  if (options.explain) checker.enable_explain();
   for (const auto& p : properties) {
     try {
       checker.add_property(p);

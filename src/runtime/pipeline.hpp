@@ -31,6 +31,7 @@ struct PipelineOptions {
   size_t max_reported = 100;           // errors and warnings printed before going quiet
   bool parse_only = false;             // decode every message but run no monitor (benchmark floor)
   bool robustness = false;             // robustness values instead of Booleans (discrete, JSON)
+  bool explain = false;                // a violation's verdict says why (discrete)
   size_t max_message_size = 1 << 20;   // longest message: a line, a payload, a line inside a batched payload
   // Typed input (--type): each payload is one CDR sample of this type,
   // decoded straight into the tests' values (properties are checked against

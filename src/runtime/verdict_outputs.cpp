@@ -3,6 +3,7 @@
 #include <stdexcept>
 
 #include "io/cdr_codec.hpp"
+#include "io/json_writer.hpp"
 #include "io/verdict_writer.hpp"
 
 namespace rvc::runtime {
@@ -12,6 +13,15 @@ void VerdictOutputs::put(const engine::Verdict& v) {
   line_.clear();
   if (v.robust) io::append_robustness(line_, v.time, discrete_, v.property, v.robustness);
   else io::append_verdict(line_, v.time, discrete_, v.property, v.value);
+  if (v.explanation && !type_) {  // {"time":..,"value":false,"explain":["...", ...]} (typed verdicts have no field for it)
+    line_.resize(line_.size() - 2);  // "}\n"
+    line_ += ",\"explain\":[";
+    for (size_t i = 0; i < v.explanation->size(); ++i) {
+      if (i) line_ += ',';
+      io::append_json_string(line_, (*v.explanation)[i]);
+    }
+    line_ += "]}\n";
+  }
   line_.pop_back();  // one message per verdict: no newline (file sinks add their own)
   put_payload(line_);
 }

@@ -3,13 +3,14 @@
 #include <algorithm>
 #include <cstring>
 #include <stdexcept>
+#include <string>
 
 namespace rvc::engine::discrete {
 namespace {
 Step to_step(double v) { return v >= static_cast<double>(kForever) ? kForever : static_cast<Step>(v); }
 }  // namespace
 
-Monitor::Monitor(const Program& program) {
+Monitor::Monitor(const Program& program) : program_(program) {
   // Local slots for the atoms this property reads (the shared table may hold
   // many more, from other properties).
   std::vector<int32_t> local(program.code.size(), -1);
@@ -56,6 +57,7 @@ Monitor::Monitor(const Program& program) {
     operand[i] = {op.out, 0};
   }
   root_ = operand.back();
+  operand_ = std::move(operand);
   value_.assign(slots, 0);
   value_[one] = 1;
 }
@@ -89,6 +91,89 @@ bool Monitor::step(const uint8_t* atoms) {
   }
   now_ = now + 1;
   return v[root_.slot] ^ root_.negate;
+}
+
+namespace {
+
+// "at step 4", "at steps 0..4": the steps an operator's bounds look at now.
+std::string range_text(Step now, const spec::Bounds& b) {
+  const Step from = b.hi >= static_cast<double>(kForever) ? 0 : std::max<Step>(0, now - static_cast<Step>(b.hi));
+  const Step to = now - static_cast<Step>(b.lo);
+  if (to < from) return "at no step yet";
+  return from == to ? "at step " + std::to_string(from) : "at steps " + std::to_string(from) + ".." + std::to_string(to);
+}
+
+const char* word(bool v) { return v ? "true" : "false"; }
+
+}  // namespace
+
+// One sentence per sub-formula on the way from the root to the atoms (or to
+// a temporal operator, whose reason lies in earlier steps): only the
+// operands that decide the value are followed.
+void Monitor::why(size_t i, Step at, std::vector<std::string>& out) const {
+  if (out.size() >= 16) return;  // a wide formula: the first reasons are enough
+  const Instr& in = program_.code[i];
+  const std::string& text = program_.text[i];
+  const bool v = value_of(i);
+  const size_t a = static_cast<size_t>(in.a), b = static_cast<size_t>(in.b);
+  switch (in.code) {
+    case Code::Atom: out.push_back(text + " is " + word(v) + " at step " + std::to_string(at)); return;
+    case Code::True:
+    case Code::False: return;
+    case Code::Not: why(a, at, out); return;
+    case Code::And:
+      if (v) {
+        why(a, at, out);
+        why(b, at, out);
+      } else {
+        why(!value_of(a) ? a : b, at, out);
+      }
+      return;
+    case Code::Or:
+      if (v) {
+        why(value_of(a) ? a : b, at, out);
+      } else {
+        why(a, at, out);
+        why(b, at, out);
+      }
+      return;
+    case Code::Implies:
+      if (v) {
+        why(!value_of(a) ? a : b, at, out);
+      } else {
+        why(a, at, out);
+        why(b, at, out);
+      }
+      return;
+    case Code::Pre:
+      out.push_back(text + " is " + word(v) + (at == 0 ? ": there is no previous step"
+                                                      : ": " + program_.text[a] + " was " + word(v) + " at step " +
+                                                            std::to_string(at - 1)));
+      return;
+    case Code::Once:
+      out.push_back(text + " is " + word(v) + ": " + program_.text[a] + (v ? " held at least once " : " never held ") +
+                    range_text(at, in.bounds));
+      if (!v && in.bounds.lo == 0) why(a, at, out);
+      return;
+    case Code::Historically:
+      out.push_back(text + " is " + word(v) + ": " + program_.text[a] +
+                    (v ? " held every time " : " failed at least once ") + range_text(at, in.bounds));
+      if (!v && in.bounds.lo == 0 && !value_of(a)) why(a, at, out);  // failing now: the step that broke it
+      return;
+    case Code::Since:
+      out.push_back(text + " is " + word(v) + ": " + program_.text[b] +
+                    (v ? " held " + range_text(at, in.bounds) + " and " + program_.text[a] + " at every step after"
+                       : " never held " + range_text(at, in.bounds) + " with " + program_.text[a] +
+                             " holding at every step after"));
+      if (!v && !value_of(a)) why(a, at, out);  // the left side failing now ended it
+      return;
+  }
+}
+
+std::vector<std::string> Monitor::explain() const {
+  std::vector<std::string> out;
+  if (!program_.code.empty()) why(program_.code.size() - 1, now_ - 1, out);
+  return out;
 }
 
 }  // namespace rvc::engine::discrete

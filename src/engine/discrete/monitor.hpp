@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "engine/discrete/historically.hpp"
@@ -18,6 +19,12 @@ class Monitor {
   // Advances one step with the current atom values; returns the verdict.
   bool step(const uint8_t* atoms);
   Step now() const { return now_; }  // index of the next step
+
+  // After step(): why the property has its current value, as sentences
+  // naming sub-formulas and steps ("{x > 3} is false at step 12", "once[0:5]
+  // ({q}) is false: ({q}) held at no step in 7..12"). For `--explain`, at a
+  // violation: it reads the values of this step, so it costs nothing before.
+  std::vector<std::string> explain() const;
 
  private:
   // Operands are slots of one value array: this property's atoms first, then the
@@ -36,6 +43,13 @@ class Monitor {
     uint16_t slot;
     uint8_t negate;
   };
+  bool value_of(size_t instruction) const {
+    return value_[operand_[instruction].slot] ^ operand_[instruction].negate;
+  }
+  void why(size_t instruction, Step at, std::vector<std::string>& out) const;
+
+  Program program_;                // kept for explain(): codes, operands, bounds, texts
+  std::vector<Operand> operand_;   // per instruction: where its value is this step
   std::vector<Op> ops_;
   std::vector<uint8_t> value_;
   std::vector<uint32_t> atoms_;  // the shared atom table's ids this property reads, in slot order
