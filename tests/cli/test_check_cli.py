@@ -134,3 +134,31 @@ def test_timescales_is_deterministic(rvc):
     b = run(rvc, "timescales", "RespondGLB", "--ubound", "100", "--duration", "5000", "--seed", "9").stdout
     c = run(rvc, "timescales", "RespondGLB", "--ubound", "100", "--duration", "5000", "--seed", "10").stdout
     assert a == b and a != c and len(a.splitlines()) == 5000
+
+
+def test_explain_names_the_deciding_subformulas_and_steps(rvc, tmp_path):
+    trace = write(tmp_path, "e.jsonl", [
+        '{"emergency":false,"hazard":false}', '{"emergency":true,"hazard":true}', '{"emergency":true,"hazard":false}',
+        '{"emergency":true,"hazard":false}', '{"emergency":false,"hazard":false}'])
+    r = run(rvc, "check", "--explain", "--spec", "historically({emergency} -> once[0:1]{hazard})",
+            "--spec", "{emergency} or {hazard}", trace)
+    assert r.returncode == 1, r.stderr
+    assert [json.loads(l) for l in r.stdout.splitlines()] == [
+        {"time": 0, "property": "p1", "value": True},
+        {"time": 0, "property": "p2", "value": False, "explain": [
+            "{emergency} is false at step 0", "{hazard} is false at step 0"]},
+        {"time": 1, "property": "p2", "value": True},
+        {"time": 3, "property": "p1", "value": False, "explain": [
+            "(historically ({emergency} implies (once[:1] {hazard}))) is false: ({emergency} implies "
+            "(once[:1] {hazard})) failed at least once at steps 0..3",
+            "{emergency} is true at step 3",
+            "(once[:1] {hazard}) is false: {hazard} never held at steps 2..3",
+            "{hazard} is false at step 3"]},
+        {"time": 4, "property": "p2", "value": False, "explain": [
+            "{emergency} is false at step 4", "{hazard} is false at step 4"]},
+    ]
+    # Without --explain the verdicts are the same, without the reasons.
+    plain = run(rvc, "check", "--spec", "historically({emergency} -> once[0:1]{hazard})",
+                "--spec", "{emergency} or {hazard}", trace)
+    assert [json.loads(l) for l in plain.stdout.splitlines()] == [
+        {k: v for k, v in json.loads(l).items() if k != "explain"} for l in r.stdout.splitlines()]
