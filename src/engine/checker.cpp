@@ -35,8 +35,16 @@ void Checker::add_property(const PropertySpec& property) {
     last_robustness_.push_back(std::numeric_limits<double>::quiet_NaN());
   }
   try {
-    if (model_ == TimeModel::Discrete) discrete_.emplace_back(program);
-    else dense_.emplace_back(program);
+    if (model_ == TimeModel::Discrete) {
+      if (discrete_.empty() || !discrete_.back().add(program)) {
+        discrete_.emplace_back();
+        discrete_.back().add(program);  // alone in a new monitor: fits, or throws length_error
+      }
+      where_.emplace_back(static_cast<uint32_t>(discrete_.size() - 1),
+                          static_cast<uint32_t>(discrete_.back().size() - 1));
+    } else {
+      dense_.emplace_back(program);
+    }
   } catch (const std::length_error& e) {  // the monitor's size limit: a spec problem, not a runtime failure
     throw spec::SpecError(std::string(e.what()) + "; split it into several properties", property.spec, 1);
   }
@@ -52,11 +60,14 @@ void Checker::report(size_t property, double time, bool value, const std::vector
 }
 
 void Checker::step(const uint8_t* atoms) {
-  for (size_t i = 0; i < discrete_.size(); ++i) {
-    double now = static_cast<double>(discrete_[i].now());
-    const bool value = discrete_[i].step(atoms);
+  if (discrete_.empty()) return;
+  const double now = static_cast<double>(discrete_[0].now());
+  for (auto& m : discrete_) m.step(atoms);
+  for (size_t i = 0; i < where_.size(); ++i) {
+    const discrete::Monitor& m = discrete_[where_[i].first];
+    const bool value = m.value(where_[i].second);
     if (explain_ && !value && last_[i] != 0) {  // a violation starts: say why
-      const std::vector<std::string> why = discrete_[i].explain();
+      const std::vector<std::string> why = m.explain(where_[i].second);
       report(i, now, value, &why);
     } else {
       report(i, now, value);

@@ -72,7 +72,11 @@ class Checker {
   VerdictCallback on_verdict_;
   AtomTable atoms_;
   std::vector<std::string> names_;
+  // Discrete time: all properties in shared monitors (common sub-formulas
+  // stepped once), a new one when the last is full; property k is in
+  // discrete_[where_[k].first] at index where_[k].second.
   std::vector<discrete::Monitor> discrete_;
+  std::vector<std::pair<uint32_t, uint32_t>> where_;
   std::vector<dense::Monitor> dense_;
   bool robustness_ = false;
   bool explain_ = false;

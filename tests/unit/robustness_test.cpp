@@ -69,31 +69,3 @@ TEST(RobustChecker, BoundedSinceIsRefusedWithItsReason) {
 }  // namespace
 }  // namespace rvc::engine::robust
 
-namespace rvc::engine {
-namespace {
-
-// --explain: the sentences a violation carries, written down by hand.
-TEST(Explain, AViolationSaysWhichSubformulasAndSteps) {
-  std::vector<std::pair<double, std::vector<std::string>>> got;
-  Checker checker(TimeModel::Discrete, false, [&](const Verdict& v) {
-    if (v.explanation) got.emplace_back(v.time, *v.explanation);
-  });
-  checker.enable_explain();
-  checker.add_property({"p", "historically({e} -> once[0:1]{h})"});
-  // atoms: {e}, {h}
-  const uint8_t steps[][2] = {{0, 0}, {0, 1}, {1, 1}, {1, 0}, {1, 0}, {1, 0}};
-  for (const auto& m : steps) checker.step(m);
-  ASSERT_EQ(got.size(), 1u);  // one violation, explained once (not at every false step)
-  EXPECT_EQ(got[0].first, 4);
-  EXPECT_EQ(got[0].second,
-            (std::vector<std::string>{
-                "(historically ({e} implies (once[:1] {h}))) is false: ({e} implies (once[:1] {h})) failed at least "
-                "once at steps 0..4",
-                "{e} is true at step 4", "(once[:1] {h}) is false: {h} never held at steps 3..4",
-                "{h} is false at step 4"}));
-  Checker dense(TimeModel::Dense, false, nullptr);
-  EXPECT_THROW(dense.enable_explain(), std::invalid_argument);
-}
-
-}  // namespace
-}  // namespace rvc::engine

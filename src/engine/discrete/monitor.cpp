@@ -8,41 +8,54 @@
 namespace rvc::engine::discrete {
 namespace {
 Step to_step(double v) { return v >= static_cast<double>(kForever) ? kForever : static_cast<Step>(v); }
+constexpr size_t kMaxSlots = 65535;
 }  // namespace
 
-Monitor::Monitor(const Program& program) : program_(program) {
-  // Local slots for the atoms this property reads (the shared table may hold
-  // many more, from other properties).
-  std::vector<int32_t> local(program.code.size(), -1);
-  for (size_t i = 0; i < program.code.size(); ++i) {
-    const Instr& in = program.code[i];
-    if (in.code != Code::Atom) continue;
-    auto found = std::find(atoms_.begin(), atoms_.end(), static_cast<uint32_t>(in.atom));
-    local[i] = static_cast<int32_t>(found - atoms_.begin());
-    if (found == atoms_.end()) atoms_.push_back(static_cast<uint32_t>(in.atom));
+Monitor::Monitor() : value_{0, 1} {}  // slot 0: false, slot 1: true
+
+bool Monitor::add(const Program& program) {
+  if (now_ > 0) throw std::logic_error("discrete::Monitor::add after the first step");
+  // At most one new slot per instruction.
+  if (value_.size() + program.code.size() > kMaxSlots) {
+    if (properties_.empty()) throw std::length_error("property too large (more than 65000 nodes)");
+    return false;
   }
-  const size_t zero = atoms_.size(), one = atoms_.size() + 1;
-  size_t slots = atoms_.size() + 2;
-  if (slots + program.code.size() > 65535) throw std::length_error("property too large (more than 65000 nodes)");
-  std::vector<Operand> operand(program.code.size());
+  Property p;
+  p.program = program;
+  p.operand.resize(program.code.size());
   for (size_t i = 0; i < program.code.size(); ++i) {
     const Instr& in = program.code[i];
     switch (in.code) {
-      case Code::True: operand[i] = {static_cast<uint16_t>(one), 0}; continue;
-      case Code::False: operand[i] = {static_cast<uint16_t>(zero), 0}; continue;
-      case Code::Atom: operand[i] = {static_cast<uint16_t>(local[i]), 0}; continue;
-      case Code::Not: operand[i] = {operand[in.a].slot, static_cast<uint8_t>(!operand[in.a].negate)}; continue;
+      case Code::True: p.operand[i] = {1, 0}; continue;
+      case Code::False: p.operand[i] = {0, 0}; continue;
+      case Code::Atom: {
+        auto [it, added] = atom_slot_of_.try_emplace(static_cast<uint32_t>(in.atom), static_cast<uint16_t>(value_.size()));
+        if (added) {
+          value_.push_back(0);
+          atom_ids_.push_back(static_cast<uint32_t>(in.atom));
+          atom_slots_.push_back(it->second);
+        }
+        p.operand[i] = {it->second, 0};
+        continue;
+      }
+      case Code::Not: p.operand[i] = {p.operand[in.a].slot, static_cast<uint8_t>(!p.operand[in.a].negate)}; continue;
       default: break;
     }
-    Op op{in.code};
-    op.a = operand[in.a].slot;
-    op.negate_a = operand[in.a].negate;
-    if (in.b >= 0) {
-      op.b = operand[in.b].slot;
-      op.negate_b = operand[in.b].negate;
+    const Operand a = p.operand[in.a];
+    const Operand b = in.b >= 0 ? p.operand[in.b] : Operand{};
+    const Key key{in.code, a.slot, a.negate, b.slot, b.negate, in.bounds.lo, in.bounds.hi};
+    if (auto found = shared_.find(key); found != shared_.end()) {  // the same sub-formula: one operator
+      p.operand[i] = {found->second, 0};
+      continue;
     }
-    op.out = static_cast<uint16_t>(slots++);
-    Step lo = to_step(in.bounds.lo), hi = to_step(in.bounds.hi);
+    Op op{in.code};
+    op.a = a.slot;
+    op.negate_a = a.negate;
+    op.b = b.slot;
+    op.negate_b = b.negate;
+    op.out = static_cast<uint16_t>(value_.size());
+    value_.push_back(0);
+    const Step lo = to_step(in.bounds.lo), hi = to_step(in.bounds.hi);
     switch (in.code) {
       case Code::Pre: op.slot = static_cast<uint16_t>(pre_.size()); pre_.emplace_back(); break;
       case Code::Once: op.slot = static_cast<uint16_t>(once_.size()); once_.push_back(Once{lo, hi, {}}); break;
@@ -54,18 +67,17 @@ Monitor::Monitor(const Program& program) : program_(program) {
       default: break;
     }
     ops_.push_back(op);
-    operand[i] = {op.out, 0};
+    shared_.emplace(key, op.out);
+    p.operand[i] = {op.out, 0};
   }
-  root_ = operand.back();
-  operand_ = std::move(operand);
-  value_.assign(slots, 0);
-  value_[one] = 1;
+  p.root = p.operand.back();
+  properties_.push_back(std::move(p));
+  return true;
 }
 
-bool Monitor::step(const uint8_t* atoms) {
+void Monitor::step(const uint8_t* atoms) {
   uint8_t* v = value_.data();
-  const uint32_t* ids = atoms_.data();
-  for (size_t k = 0, n = atoms_.size(); k < n; ++k) v[k] = atoms[ids[k]];
+  for (size_t k = 0, n = atom_ids_.size(); k < n; ++k) v[atom_slots_[k]] = atoms[atom_ids_[k]];
   const Step now = now_;
   // Locals, not members: stores through uint8_t* may alias anything, which
   // would make the compiler reload every member pointer after each node.
@@ -90,7 +102,6 @@ bool Monitor::step(const uint8_t* atoms) {
     v[op->out] = r;
   }
   now_ = now + 1;
-  return v[root_.slot] ^ root_.negate;
 }
 
 namespace {
@@ -110,69 +121,70 @@ const char* word(bool v) { return v ? "true" : "false"; }
 // One sentence per sub-formula on the way from the root to the atoms (or to
 // a temporal operator, whose reason lies in earlier steps): only the
 // operands that decide the value are followed.
-void Monitor::why(size_t i, Step at, std::vector<std::string>& out) const {
+void Monitor::why(const Property& p, size_t i, Step at, std::vector<std::string>& out) const {
   if (out.size() >= 16) return;  // a wide formula: the first reasons are enough
-  const Instr& in = program_.code[i];
-  const std::string& text = program_.text[i];
-  const bool v = value_of(i);
+  const Instr& in = p.program.code[i];
+  const std::string& text = p.program.text[i];
+  const bool v = read(p.operand[i]);
   const size_t a = static_cast<size_t>(in.a), b = static_cast<size_t>(in.b);
   switch (in.code) {
     case Code::Atom: out.push_back(text + " is " + word(v) + " at step " + std::to_string(at)); return;
     case Code::True:
     case Code::False: return;
-    case Code::Not: why(a, at, out); return;
+    case Code::Not: why(p, a, at, out); return;
     case Code::And:
       if (v) {
-        why(a, at, out);
-        why(b, at, out);
+        why(p, a, at, out);
+        why(p, b, at, out);
       } else {
-        why(!value_of(a) ? a : b, at, out);
+        why(p, !read(p.operand[a]) ? a : b, at, out);
       }
       return;
     case Code::Or:
       if (v) {
-        why(value_of(a) ? a : b, at, out);
+        why(p, read(p.operand[a]) ? a : b, at, out);
       } else {
-        why(a, at, out);
-        why(b, at, out);
+        why(p, a, at, out);
+        why(p, b, at, out);
       }
       return;
     case Code::Implies:
       if (v) {
-        why(!value_of(a) ? a : b, at, out);
+        why(p, !read(p.operand[a]) ? a : b, at, out);
       } else {
-        why(a, at, out);
-        why(b, at, out);
+        why(p, a, at, out);
+        why(p, b, at, out);
       }
       return;
     case Code::Pre:
       out.push_back(text + " is " + word(v) + (at == 0 ? ": there is no previous step"
-                                                      : ": " + program_.text[a] + " was " + word(v) + " at step " +
+                                                      : ": " + p.program.text[a] + " was " + word(v) + " at step " +
                                                             std::to_string(at - 1)));
       return;
     case Code::Once:
-      out.push_back(text + " is " + word(v) + ": " + program_.text[a] + (v ? " held at least once " : " never held ") +
+      out.push_back(text + " is " + word(v) + ": " + p.program.text[a] + (v ? " held at least once " : " never held ") +
                     range_text(at, in.bounds));
-      if (!v && in.bounds.lo == 0) why(a, at, out);
+      if (!v && in.bounds.lo == 0) why(p, a, at, out);
       return;
     case Code::Historically:
-      out.push_back(text + " is " + word(v) + ": " + program_.text[a] +
+      out.push_back(text + " is " + word(v) + ": " + p.program.text[a] +
                     (v ? " held every time " : " failed at least once ") + range_text(at, in.bounds));
-      if (!v && in.bounds.lo == 0 && !value_of(a)) why(a, at, out);  // failing now: the step that broke it
+      if (!v && in.bounds.lo == 0 && !read(p.operand[a])) why(p, a, at, out);  // failing now: the step that broke it
       return;
     case Code::Since:
-      out.push_back(text + " is " + word(v) + ": " + program_.text[b] +
-                    (v ? " held " + range_text(at, in.bounds) + " and " + program_.text[a] + " at every step after"
-                       : " never held " + range_text(at, in.bounds) + " with " + program_.text[a] +
+      out.push_back(text + " is " + word(v) + ": " + p.program.text[b] +
+                    (v ? " held " + range_text(at, in.bounds) + " and " + p.program.text[a] + " at every step after"
+                       : " never held " + range_text(at, in.bounds) + " with " + p.program.text[a] +
                              " holding at every step after"));
-      if (!v && !value_of(a)) why(a, at, out);  // the left side failing now ended it
+      if (!v && !read(p.operand[a])) why(p, a, at, out);  // the left side failing now ended it
       return;
   }
 }
 
-std::vector<std::string> Monitor::explain() const {
+std::vector<std::string> Monitor::explain(size_t k) const {
   std::vector<std::string> out;
-  if (!program_.code.empty()) why(program_.code.size() - 1, now_ - 1, out);
+  const Property& p = properties_[k];
+  if (!p.program.code.empty()) why(p, p.program.code.size() - 1, now_ - 1, out);
   return out;
 }
 

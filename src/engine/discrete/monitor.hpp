@@ -1,8 +1,16 @@
-// Discrete-time monitor of one property: one call to step() per message.
+// Discrete-time monitor of many properties at once: one call to step() per
+// message evaluates them all.
+//
+// Properties share what they have in common: an identical sub-formula over
+// the same operands (once{q} in a hundred properties) is one operator,
+// stepped once per message for all of them. Sharing is structural and
+// bottom-up, so it finds every common sub-formula, however it was written.
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "engine/discrete/historically.hpp"
@@ -15,22 +23,33 @@ namespace rvc::engine::discrete {
 
 class Monitor {
  public:
-  explicit Monitor(const Program& program);
-  // Advances one step with the current atom values; returns the verdict.
-  bool step(const uint8_t* atoms);
-  Step now() const { return now_; }  // index of the next step
+  Monitor();
+  // Adds a property (before the first step). False, and nothing added, if
+  // it would not fit (65,000 slots): the caller starts another Monitor.
+  // Throws std::length_error for a property that alone is too large.
+  bool add(const Program& program);
+  size_t size() const { return properties_.size(); }
 
-  // After step(): why the property has its current value, as sentences
-  // naming sub-formulas and steps ("{x > 3} is false at step 12", "once[0:5]
-  // ({q}) is false: ({q}) held at no step in 7..12"). For `--explain`, at a
-  // violation: it reads the values of this step, so it costs nothing before.
-  std::vector<std::string> explain() const;
+  // Advances one step with the current atom values (indexed by the shared
+  // atom table); then value(k) is property k's verdict.
+  void step(const uint8_t* atoms);
+  bool value(size_t k) const { return read(properties_[k].root); }
+  Step now() const { return now_; }  // index of the next step
+  size_t operators() const { return ops_.size(); }  // after sharing (benchmarks, tests)
+
+  // After step(): why property k has its current value, as sentences naming
+  // sub-formulas and steps ("{x > 3} is false at step 12"). For --explain, at
+  // a violation: it reads this step's values, so it costs nothing before.
+  std::vector<std::string> explain(size_t k) const;
 
  private:
-  // Operands are slots of one value array: this property's atoms first, then the
-  // constants 0 and 1, then each operator's output. Atoms, constants and
-  // negations are not operators at all: `not` is a flag on the operand that
-  // reads it. A Timescales property shrinks from 12 nodes to 6 this way.
+  // Operands are slots of one value array: the constants 0 and 1, the atoms
+  // read, and each operator's output. Atoms, constants and negations are not
+  // operators at all: `not` is a flag on the operand that reads it.
+  struct Operand {
+    uint16_t slot = 0;
+    uint8_t negate = 0;
+  };
   struct Op {
     Code code;
     uint8_t negate_a = 0, negate_b = 0;
@@ -39,21 +58,24 @@ class Monitor {
     uint16_t out = 0;       // result slot
     uint16_t slot = 0;      // index into the state array of its operator
   };
-  struct Operand {
-    uint16_t slot;
-    uint8_t negate;
+  struct Property {
+    Program program;                // for explain(): codes, operands, bounds, texts
+    std::vector<Operand> operand;   // per instruction: where its value is
+    Operand root;
   };
-  bool value_of(size_t instruction) const {
-    return value_[operand_[instruction].slot] ^ operand_[instruction].negate;
-  }
-  void why(size_t instruction, Step at, std::vector<std::string>& out) const;
+  // What makes two operators the same: code, operands, bounds.
+  using Key = std::tuple<Code, uint16_t, uint8_t, uint16_t, uint8_t, double, double>;
 
-  Program program_;                // kept for explain(): codes, operands, bounds, texts
-  std::vector<Operand> operand_;   // per instruction: where its value is this step
+  bool read(Operand o) const { return value_[o.slot] ^ o.negate; }
+  void why(const Property& p, size_t instruction, Step at, std::vector<std::string>& out) const;
+
   std::vector<Op> ops_;
   std::vector<uint8_t> value_;
-  std::vector<uint32_t> atoms_;  // the shared atom table's ids this property reads, in slot order
-  Operand root_{};
+  std::vector<uint32_t> atom_ids_;    // the shared atom table's ids read, ...
+  std::vector<uint16_t> atom_slots_;  // ... and their slots
+  std::map<uint32_t, uint16_t> atom_slot_of_;
+  std::map<Key, uint16_t> shared_;    // operator -> its output slot
+  std::vector<Property> properties_;
   std::vector<Pre> pre_;
   std::vector<Once> once_;
   std::vector<Historically> historically_;
