@@ -14,6 +14,10 @@ void CheckOptions::add_to(CLI::App& app) {
                "positive holds) instead of true/false; discrete time, JSON input (docs/semantics.md)");
   app.add_flag("--explain", explain,
                "With each violation, say why: the sub-formulas and steps that made the verdict false (discrete time)");
+  app.add_option("--max-data-values", max_data_values,
+                 "Data references (exists[x]. {id: *x}): the most distinct values one variable may take; more stops "
+                 "the run with an error (memory and time per message grow with them)")
+      ->capture_default_str();
   app.add_flag("--strict", strict, "Reject messages missing a field a property tests, or with wrong types");
   app.add_option("--time-field", time_field,
                  "Field holding the time in dense time: a path (header.stamp) to seconds or a Time {sec, nanosec} "
@@ -52,6 +56,7 @@ PipelineOptions CheckOptions::pipeline_options() const {
   o.parse_only = parse_only;
   o.robustness = robustness;
   o.explain = explain;
+  o.max_data_values = max_data_values;
   o.max_message_size = max_message_size;
   return o;
 }

@@ -25,6 +25,7 @@ struct CheckOptions {
   bool parse_only = false;
   bool robustness = false;
   bool explain = false;
+  uint32_t max_data_values = 100000;
 
   void add_to(CLI::App& app);
   // The properties from --spec (named p1, p2, ...) and --properties.

@@ -28,6 +28,21 @@ void Checker::add_property(const PropertySpec& property) {
   options.dense = model_ == TimeModel::Dense;
   spec::NodePtr ast = spec::parse(property.spec, options);
   Program program = compile(*ast, atoms_, model_, property.spec);
+  if (program.has_data()) {
+    if (robustness_)
+      throw spec::SpecError("--robustness has no meaning for data references (exists/forall), as in Reelay",
+                            property.spec, 1);
+    if (model_ == TimeModel::Dense) {
+      dense_data_.emplace_back(program, property.name, max_data_values_);
+      where_.emplace_back(kData, static_cast<uint32_t>(dense_data_.size() - 1));
+    } else {
+      data_.emplace_back(program, property.name, max_data_values_);
+      where_.emplace_back(kData, static_cast<uint32_t>(data_.size() - 1));
+    }
+    names_.push_back(property.name);
+    last_.push_back(-1);
+    return;
+  }
   if (robustness_) {
     if (std::string why = robust::Monitor::unsupported(program); !why.empty())
       throw spec::SpecError(why, property.spec, 1);
@@ -44,6 +59,7 @@ void Checker::add_property(const PropertySpec& property) {
                           static_cast<uint32_t>(discrete_.back().size() - 1));
     } else {
       dense_.emplace_back(program);
+      where_.emplace_back(0, static_cast<uint32_t>(dense_.size() - 1));
     }
   } catch (const std::length_error& e) {  // the monitor's size limit: a spec problem, not a runtime failure
     throw spec::SpecError(std::string(e.what()) + "; split it into several properties", property.spec, 1);
@@ -59,11 +75,15 @@ void Checker::report(size_t property, double time, bool value, const std::vector
   if (on_verdict_) on_verdict_(Verdict{names_[property], time, value, false, 0, explanation});
 }
 
-void Checker::step(const uint8_t* atoms) {
-  if (discrete_.empty()) return;
-  const double now = static_cast<double>(discrete_[0].now());
+void Checker::step(const uint8_t* atoms, const uint32_t* bound) {
+  if (where_.empty()) return;
+  const double now = static_cast<double>(now_discrete_++);
   for (auto& m : discrete_) m.step(atoms);
   for (size_t i = 0; i < where_.size(); ++i) {
+    if (where_[i].first == kData) {
+      report(i, now, data_[where_[i].second].step(atoms, bound));
+      continue;
+    }
     const discrete::Monitor& m = discrete_[where_[i].first];
     const bool value = m.value(where_[i].second);
     if (explain_ && !value && last_[i] != 0) {  // a violation starts: say why
@@ -88,10 +108,12 @@ void Checker::step_robust(const double* margins) {
   }
 }
 
-void Checker::step(double begin, double end, const uint8_t* atoms) {
+void Checker::step(double begin, double end, const uint8_t* atoms, const uint32_t* bound) {
   if (!(begin < end)) return;  // an empty segment has no value to report
-  for (size_t i = 0; i < dense_.size(); ++i) {
-    const dense::Signal& s = dense_[i].step(begin, end, atoms);
+  for (size_t i = 0; i < where_.size(); ++i) {
+    const auto [kind, k] = where_[i];
+    const dense::Signal& s =
+        kind == kData ? dense_data_[k].step(begin, end, atoms, bound) : dense_[k].step(begin, end, atoms);
     for (const dense::Piece& p : s.pieces) report(i, p.t, p.v);
   }
 }

@@ -12,6 +12,8 @@
 #include <vector>
 
 #include "engine/atom_table.hpp"
+#include "engine/data/dense_monitor.hpp"
+#include "engine/data/discrete_monitor.hpp"
 #include "engine/dense/monitor.hpp"
 #include "engine/discrete/monitor.hpp"
 #include "engine/program.hpp"
@@ -45,6 +47,10 @@ class Checker {
   // --explain: each violation's verdict carries why (discrete time).
   void enable_explain();
   bool robustness() const { return robustness_; }
+  // Data references: the most distinct values one quantified variable may
+  // take (--max-data-values); beyond, step() throws data::DataLimitError.
+  void set_max_data_values(uint32_t n) { max_data_values_ = n; }
+  bool has_data_references() const { return !data_.empty() || !dense_data_.empty(); }
 
   // Parses and compiles; throws spec::SpecError naming the column.
   void add_property(const PropertySpec& property);
@@ -55,12 +61,14 @@ class Checker {
   size_t size() const { return names_.size(); }
   const std::vector<std::string>& names() const { return names_; }
 
-  // Discrete time: one step with the atoms' values after the message.
-  void step(const uint8_t* atoms);
+  // Discrete time: one step with the atoms' values after the message and,
+  // for properties with data references, the bound values' ids (the
+  // decoder's bound(); null when no test binds).
+  void step(const uint8_t* atoms, const uint32_t* bound = nullptr);
   // Robustness, discrete time: one step with the atoms' margins.
   void step_robust(const double* margins);
   // Dense time: the atoms' values held over [begin, end).
-  void step(double begin, double end, const uint8_t* atoms);
+  void step(double begin, double end, const uint8_t* atoms, const uint32_t* bound = nullptr);
 
   uint64_t violations() const { return violations_; }  // verdicts reported false
 
@@ -76,13 +84,19 @@ class Checker {
   // stepped once), a new one when the last is full; property k is in
   // discrete_[where_[k].first] at index where_[k].second.
   std::vector<discrete::Monitor> discrete_;
+  // where_[k].first == kData: property k has data references, in data_.
   std::vector<std::pair<uint32_t, uint32_t>> where_;
+  static constexpr uint32_t kData = UINT32_MAX;
+  std::vector<data::DiscreteMonitor> data_;
+  std::vector<data::DenseMonitor> dense_data_;
+  uint32_t max_data_values_ = 100000;
   std::vector<dense::Monitor> dense_;
   bool robustness_ = false;
   bool explain_ = false;
   std::vector<robust::Monitor> robust_;
   std::vector<double> last_robustness_;
   int64_t now_robust_ = 0;
+  int64_t now_discrete_ = 0;
   std::vector<int8_t> last_;  // last reported value per property, -1 before the first
   uint64_t violations_ = 0;
 };

@@ -10,6 +10,7 @@ struct Compiler {
   TimeModel model;
   const std::string& source;
   Program program;
+  std::vector<std::pair<std::string, int32_t>> scope;  // quantified variables in scope, innermost last
 
   [[noreturn]] void fail(const std::string& message, int column) { throw spec::SpecError(message, source, column); }
 
@@ -27,15 +28,15 @@ struct Compiler {
       case Op::True: in.code = Code::True; return emit(in, n);
       case Op::False: in.code = Code::False; return emit(in, n);
       case Op::Test:
-        if (n.test.op == spec::FieldTest::Op::Bind)
-          fail("data references ({key: *var}) are not yet supported by rvc's monitors", n.column);
         in.code = Code::Atom;
+        if (n.test.op == spec::FieldTest::Op::Bind) {
+          in.code = Code::Bind;
+          in.var = lookup(n.test.variable, n.column);
+        }
         in.atom = atoms.intern(n.test);
         return emit(in, n);
       case Op::Exists:
-      case Op::Forall:
-        fail(std::string("'") + spec::op_name(n.op) + "' (data quantifiers) is not yet supported by rvc's monitors",
-             n.column);
+      case Op::Forall: return quantify(n, 0);
       case Op::Pre:
         if (model == TimeModel::Dense)
           fail("'pre' has no meaning in dense time (there is no previous step); use once[a:b] or discrete time",
@@ -54,12 +55,37 @@ struct Compiler {
     if (n.right) in.b = visit(*n.right);
     return emit(in, n);
   }
+
+  // The innermost variable of that name in scope.
+  int32_t lookup(const std::string& name, int column) {
+    for (auto it = scope.rbegin(); it != scope.rend(); ++it)
+      if (it->first == name) return it->second;
+    fail("variable '" + name + "' is not bound: put the test inside exists[" + name + "]. ... or forall[" + name +
+             "]. ...",
+         column);
+  }
+
+  // exists[x, y]. φ is exists[x]. exists[y]. φ: one instruction per variable.
+  int32_t quantify(const spec::Node& n, size_t first) {
+    if (program.variables.size() >= kMaxVariables)
+      fail("more than " + std::to_string(kMaxVariables) + " quantified variables in one property (the limit)",
+           n.column);
+    const auto var = static_cast<int32_t>(program.variables.size());
+    program.variables.push_back(n.variables[first]);
+    scope.emplace_back(n.variables[first], var);
+    Instr in{};
+    in.code = n.op == spec::Op::Exists ? Code::Exists : Code::Forall;
+    in.var = var;
+    in.a = first + 1 < n.variables.size() ? quantify(n, first + 1) : visit(*n.left);
+    scope.pop_back();
+    return emit(in, n);
+  }
 };
 
 }  // namespace
 
 Program compile(const spec::Node& root, AtomTable& atoms, TimeModel model, const std::string& source) {
-  Compiler c{atoms, model, source, {}};
+  Compiler c{atoms, model, source, {}, {}};
   c.visit(root);
   return std::move(c.program);
 }

@@ -67,6 +67,7 @@ CdrDecoder::CdrDecoder(const engine::AtomTable& atoms, const MessageType& type, 
       continue;
     plan_path(tests[id].path).tests.push_back(static_cast<int>(id));
     if (tests[id].op == FOp::Present) presence_tests_.push_back(static_cast<int>(id));
+    if (tests[id].op == FOp::Bind && bound_.empty()) bound_.assign(tests.size(), 0), next_bound_ = bound_;
   }
   if (options_.need_time) plan_time(options_.time_field);
 }
@@ -163,6 +164,7 @@ void CdrDecoder::plan_time(const std::string& time_field) {
 
 bool CdrDecoder::decode(std::string_view sample, std::string& error, std::vector<std::string>* warnings) {
   std::copy(current_.begin(), current_.end(), next_.begin());  // (memcpy of no atoms: null pointers)
+  std::copy(bound_.begin(), bound_.end(), next_bound_.begin());
   // Fields are always there, array elements not ({pts[3]: *}): presence is
   // false until the decoder passes the value.
   for (int id : presence_tests_) next_[id] = 0;
@@ -275,6 +277,7 @@ bool CdrDecoder::apply(const FieldPlan& f, const FieldValue& v) {
     const int result = evaluate_test(t, v);
     if (result >= 0) {
       next_[id] = static_cast<uint8_t>(result);
+      if (t.op == FOp::Bind) next_bound_[id] = bound_ids_.id(v);
       continue;
     }
     const std::string problem = wrong_type_problem(t, v.kind);

@@ -45,9 +45,14 @@ class CdrDecoder {
   // appended to `warnings`.
   bool decode(std::string_view sample, std::string& error, std::vector<std::string>* warnings = nullptr);
   bool malformed() const { return malformed_; }
-  void commit() { current_.swap(next_); }
+  void commit() {
+    current_.swap(next_);
+    bound_.swap(next_bound_);
+  }
 
   const uint8_t* values() const { return current_.data(); }
+  // Data references: per atom, the id of the value bound last (as JsonDecoder::bound).
+  const uint32_t* bound() const { return bound_.empty() ? nullptr : bound_.data(); }
   double time() const { return time_; }
 
   // "time" -> the field dense time reads in a message of this type when the
@@ -88,6 +93,8 @@ class CdrDecoder {
   Plan root_;
   std::vector<int> presence_tests_;
   std::vector<uint8_t> current_, next_;
+  std::vector<uint32_t> bound_, next_bound_;  // sized only when some test binds
+  BoundValues bound_ids_;
   double time_ = 0, next_time_ = 0;
   double sec_ = 0, nanosec_ = 0;
   bool malformed_ = false;

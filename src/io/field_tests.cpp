@@ -23,6 +23,7 @@ namespace {
 
 const char* expected_for(const spec::FieldTest& t) {
   if (t.op == FOp::Truthy) return "a Boolean or number";
+  if (t.op == FOp::Bind) return "a string, number or Boolean to bind";
   switch (t.value.kind) {
     case spec::Literal::Kind::Bool: return "a Boolean";
     case spec::Literal::Kind::Number: return "a number";
@@ -42,8 +43,9 @@ int evaluate_test(const spec::FieldTest& t, const FieldValue& v) {
   const auto lit = t.value.kind;
   const bool number = v.kind == ValueKind::Number;
   switch (t.op) {
-    case FOp::Present:
-    case FOp::Bind: return 1;
+    case FOp::Present: return 1;
+    case FOp::Bind:  // binds scalars; null is no value (as a missing field)
+      return v.kind == ValueKind::String || v.kind == ValueKind::Number || v.kind == ValueKind::Bool ? 1 : -1;
     case FOp::Truthy:
       if (v.kind == ValueKind::Bool) return v.b;
       if (number) return v.d != 0;

@@ -127,6 +127,7 @@ JsonDecoder::JsonDecoder(const engine::AtomTable& atoms, DecoderOptions options)
     for (const std::string& part : tests[id].path) node = child(*node, part);
     node->tests.push_back(static_cast<int>(id));
     if (tests[id].op == FOp::Present) presence_tests_.push_back(static_cast<int>(id));
+    if (tests[id].op == FOp::Bind && bound_.empty()) bound_.assign(tests.size(), 0), next_bound_ = bound_;
   }
   if (options_.need_time) {
     KeyNode* t = &root_;  // a path, as in specs: "header.stamp"
@@ -235,6 +236,7 @@ bool JsonDecoder::invalid(std::string& error, simdjson::error_code err, const st
 
 bool JsonDecoder::decode(simdjson::ondemand::object object, std::string& error, std::vector<std::string>* warnings) {
   std::copy(current_.begin(), current_.end(), next_.begin());  // (memcpy of no atoms: null pointers)
+  std::copy(bound_.begin(), bound_.end(), next_bound_.begin());
   for (int id : presence_tests_) next_[id] = 0;
   if (options_.robustness) {
     std::copy(margin_.begin(), margin_.end(), next_margin_.begin());
@@ -425,6 +427,7 @@ bool JsonDecoder::apply_tests(KeyNode& node, simdjson::ondemand::value value, js
     if (result >= 0) {
       next_[id] = static_cast<uint8_t>(result);
       if (options_.robustness) next_margin_[id] = test_margin(t, v);
+      if (t.op == FOp::Bind) next_bound_[id] = bound_ids_.id(v);
       continue;
     }
     if (type == json_type::null && !options_.strict) continue;  // null: no value, like a missing field

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "engine/atom_table.hpp"
+#include "io/bound_values.hpp"
 
 namespace rvc::io {
 
@@ -40,10 +41,14 @@ class JsonDecoder {
   // Makes the last successful decode current.
   void commit() {
     current_.swap(next_);
+    bound_.swap(next_bound_);
     if (options_.robustness) margin_.swap(next_margin_);
   }
 
   const uint8_t* values() const { return current_.data(); }
+  // Data references ({id: *x}): per atom, the id of the value its field held
+  // last (BoundValues; 0 before any); null when no test binds.
+  const uint32_t* bound() const { return bound_.empty() ? nullptr : bound_.data(); }
   // With DecoderOptions::robustness: each test's robustness (io::test_margin);
   // -inf for a field never seen, as Reelay starts.
   const double* margins() const { return margin_.data(); }
@@ -100,6 +105,8 @@ class JsonDecoder {
   KeyNode root_;
   std::vector<int> presence_tests_;
   std::vector<uint8_t> current_, next_;
+  std::vector<uint32_t> bound_, next_bound_;  // sized only when some test binds
+  BoundValues bound_ids_;
   std::vector<double> margin_, next_margin_;
   double time_ = 0, next_time_ = 0;
   bool saw_time_ = false;

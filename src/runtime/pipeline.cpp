@@ -21,6 +21,7 @@ engine::Checker build(const std::vector<engine::PropertySpec>& properties, const
     checker.enable_robustness();
   }
   if (options.explain) checker.enable_explain();
+  checker.set_max_data_values(options.max_data_values);
   for (const auto& p : properties) {
     try {
       checker.add_property(p);
@@ -145,7 +146,7 @@ void Pipeline::commit() {
     checker_.step_robust(decoder_.margins());
   } else if (checker_.model() == engine::TimeModel::Discrete) {
     commit_values();
-    checker_.step(values());
+    checker_.step(values(), bound());
   } else {
     // Dense: this message closes [previous time, its time) with the previous values.
     double t = message_time();
@@ -157,7 +158,7 @@ void Pipeline::commit() {
       on_error(io::LineError{pending_where_->number(), 0, why});
       return;
     }
-    checker_.step(begin, t, values());
+    checker_.step(begin, t, values(), bound());
     commit_values();
     has_time_ = true;
     last_time_ = t;

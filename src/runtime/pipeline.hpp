@@ -32,6 +32,7 @@ struct PipelineOptions {
   bool parse_only = false;             // decode every message but run no monitor (benchmark floor)
   bool robustness = false;             // robustness values instead of Booleans (discrete, JSON)
   bool explain = false;                // a violation's verdict says why (discrete)
+  uint32_t max_data_values = 100000;   // data references: distinct values per variable
   size_t max_message_size = 1 << 20;   // longest message: a line, a payload, a line inside a batched payload
   // Typed input (--type): each payload is one CDR sample of this type,
   // decoded straight into the tests' values (properties are checked against
@@ -94,6 +95,7 @@ class Pipeline final : public io::JsonlHandler, public Feed {
   // The decoder of the message being committed.
   void commit_values() { typed_ ? typed_->commit() : decoder_.commit(); }
   const uint8_t* values() const { return typed_ ? typed_->values() : decoder_.values(); }
+  const uint32_t* bound() const { return typed_ ? typed_->bound() : decoder_.bound(); }
   double message_time() const { return typed_ ? typed_->time() : decoder_.time(); }
   engine::Checker checker_;
   PipelineOptions options_;

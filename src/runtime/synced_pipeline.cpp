@@ -119,6 +119,8 @@ SyncedPipeline::SyncedPipeline(const std::vector<engine::PropertySpec>& properti
       throw spec::SpecError("in property '" + p.name + "': " + e.message(), e.source(), e.column());
     }
   }
+  if (checker_.has_data_references())
+    throw std::invalid_argument("data references (exists/forall) check one input for now (not several synchronized ones)");
   check_paths(properties, inputs, dense);
 
   inputs_.resize(inputs.size());

@@ -73,6 +73,10 @@ std::optional<spec::Literal> check_test(const spec::FieldTest& test, const Messa
   }
   const bool numeric = value.array == ArrayKind::None && value.prim != Prim::Message && value.prim != Prim::String &&
                        value.prim != Prim::WString;
+  if (test.op == spec::FieldTest::Op::Bind && (value.array != ArrayKind::None || value.prim == Prim::Message))
+    throw spec::SpecError("field '" + test.key() + "' is " + value.to_string() +
+                              ": a reference binds a string, number or Boolean field",
+                          text, test.column);
   if (!numeric || test.value.kind != spec::Literal::Kind::String || !test.value.bare_word) return std::nullopt;
   const msg::Constant* c = holder->constant(test.value.text);
   if (!c) {

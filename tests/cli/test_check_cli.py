@@ -162,3 +162,28 @@ def test_explain_names_the_deciding_subformulas_and_steps(rvc, tmp_path):
                 "--spec", "{emergency} or {hazard}", trace)
     assert [json.loads(l) for l in plain.stdout.splitlines()] == [
         {k: v for k, v in json.loads(l).items() if k != "explain"} for l in r.stdout.splitlines()]
+
+
+def test_data_references_values_limits_and_refusals(rvc, tmp_path):
+    """exists/forall from the command line: bound values keep their JSON type (3 and "3" differ,
+    3 and 3.0 do not); a field that cannot be bound keeps the last value with a warning (strict:
+    rejected); --max-data-values stops the run with an error naming property and variable; specs
+    with unbound variables point at them; robustness and synchronized inputs refuse references."""
+    trace = tmp_path / "ids.jsonl"
+    trace.write_text("".join(json.dumps(e) + "\n" for e in
+                             [{"id": 3}, {"id": "3"}, {"id": "3"}, {"id": 3.0}, {"id": 3}, {"id": [1]}, {"id": True}]))
+    spec = "exists[x]. ({id: *x} and pre{id: *x})"  # the same id twice in a row
+    r = subprocess.run([rvc, "check", "--all", "--spec", spec, str(trace)], capture_output=True, text=True)
+    values = [json.loads(line)["value"] for line in r.stdout.splitlines()]
+    assert values == [False, False, True, False, True, True, False], r.stdout
+    assert 'line 6: field "id" is an array, but {id: *x} needs a string, number or Boolean to bind' in r.stderr
+    r = subprocess.run([rvc, "check", "--strict", "--spec", spec, str(trace)], capture_output=True, text=True)
+    assert r.returncode == 1 and "rejected" in r.stderr
+    r = subprocess.run([rvc, "check", "--max-data-values", "1", "--spec", "exists[x]. {id: *x}", str(trace)],
+                       capture_output=True, text=True)
+    assert r.returncode == 5 and r.stdout.count("\n") == 1, r.stderr  # held at step 0, stopped at the 2nd value
+    assert "property 'p1': variable 'x' would take more than 1 distinct values (--max-data-values)" in r.stderr
+    r = subprocess.run([rvc, "check", "--spec", "exists[x]. {id: *y}", str(trace)], capture_output=True, text=True)
+    assert r.returncode == 2 and "column 13" in r.stderr and "variable 'y' is not bound" in r.stderr, r.stderr
+    r = subprocess.run([rvc, "check", "--robustness", "--spec", spec, str(trace)], capture_output=True, text=True)
+    assert r.returncode == 2 and "no meaning for data references" in r.stderr, r.stderr

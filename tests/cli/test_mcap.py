@@ -257,3 +257,24 @@ def test_bag_with_idl_schemas_checks_like_its_json(rvc, tmp_path):
     plain = run([rvc, "check", str(trace), "--all", "--spec", "{report == 20} -> {speed <= 0}"])
     assert typed.returncode == plain.returncode == 1, (typed.stderr, plain.stderr)
     assert typed.stdout == plain.stdout and len(typed.stdout.splitlines()) == 200
+
+
+def test_data_references_on_typed_samples(rvc, tmp_path, typestore):
+    """exists/forall binding a typed field (a uint8 here): the same verdicts as on the JSON of the
+    same values, discrete and dense; binding a message field is a spec error pointing at it."""
+    gears = gear_values(80, 9)
+    bag = write_rosbag2(tmp_path, typestore, gears, [(10**9, 0.1)])
+    spec = "exists[g]. ({report: *g} and pre(once[0:4]{report: *g}))"  # the gear was reported in the last 5
+    got = run([rvc, "check", "--all", "--spec", spec, bag, "--topic", GEAR_TOPIC])
+    want = run([rvc, "check", "--all", "--spec", spec, json_trace(tmp_path, "g.jsonl", [{"report": r} for _, r in gears])])
+    assert got.stdout == want.stdout and '"value":false' in want.stdout and '"value":true' in want.stdout, got.stderr
+    dense_spec = "forall[g]. ({report: *g} -> once[0.05:0.3]{report: *g})"
+    got = run([rvc, "check", "--dense", "--spec", dense_spec, bag, "--topic", GEAR_TOPIC])
+    want = run([rvc, "check", "--dense", "--time-field", "t", "--spec", dense_spec,
+                json_trace(tmp_path, "gt.jsonl", [{"t": t / 1e9, "report": r} for t, r in gears])])
+    assert got.stdout == want.stdout and '"value":false' in want.stdout, got.stderr
+    r = run([rvc, "check", "--spec", "exists[s]. {stamp: *s}", bag, "--topic", GEAR_TOPIC])
+    assert r.returncode == 2 and "a reference binds a string, number or Boolean field" in r.stderr, r.stderr
+    r = run([rvc, "check", "--spec", "exists[g]. {gear.report: *g}", bag, "--topic", f"gear={GEAR_TOPIC}",
+             "--topic", f"steer={STEER_TOPIC}"])
+    assert r.returncode == 2 and "data references (exists/forall) check one input for now" in r.stderr, r.stderr

@@ -182,7 +182,7 @@ TEST(ParserQuantifier, ExistsAndForallParse) {
   EXPECT_EQ(canon("{p} and (exists[x]. {id: *x})"), "({p} and (exists[x]. {id: *x}))");
 }
 
-// Compile rejects data references and quantifiers, pointing at them.
+// Compile rejects references to variables no quantifier binds, pointing at them.
 void expect_compile_error(const std::string& spec, engine::TimeModel model, const std::string& fragment, int column) {
   engine::Checker checker(model, false, nullptr);
   try {
@@ -194,16 +194,18 @@ void expect_compile_error(const std::string& spec, engine::TimeModel model, cons
   }
 }
 
-TEST(ParserQuantifier, CompileRejectsWithColumn) {
+TEST(ParserQuantifier, CompileRejectsUnboundVariablesWithColumn) {
   using engine::TimeModel;
-  expect_compile_error("{id: *x}", TimeModel::Discrete, "not yet supported", 2);
-  expect_compile_error("{id: *x}", TimeModel::Discrete, "data references", 2);
+  expect_compile_error("{id: *x}", TimeModel::Discrete, "variable 'x' is not bound", 2);
   // "{p} -> " is 7 characters; the key 'id' starts at column 9.
-  expect_compile_error("{p} -> {id: *x}", TimeModel::Discrete, "data references ({key: *var}) are not yet supported", 9);
-  expect_compile_error("exists[x]. {id: *x}", TimeModel::Discrete, "'exists' (data quantifiers) is not yet supported", 1);
-  expect_compile_error("  forall[x]. {id: *x}", TimeModel::Dense, "'forall' (data quantifiers) is not yet supported", 3);
-  // "{p} and (" is 9 characters: 'exists' is at column 10.
-  expect_compile_error("{p} and (exists[x]. {id: *x})", TimeModel::Discrete, "'exists'", 10);
+  expect_compile_error("{p} -> {id: *x}", TimeModel::Dense, "variable 'x' is not bound", 9);
+  // Bound on the left only: the right side's x is free.
+  expect_compile_error("(exists[x]. {id: *x}) and {o: *x}", TimeModel::Discrete, "variable 'x' is not bound", 28);
+  expect_compile_error("exists[x]. {id: *y}", TimeModel::Discrete, "variable 'y' is not bound", 13);
+  expect_compile_error("exists[a,b,c,d,e,f,g,h,i]. {id: *a}", TimeModel::Discrete, "more than 8 quantified variables", 1);
+  engine::Checker robust(TimeModel::Discrete, false, nullptr);
+  robust.enable_robustness();
+  EXPECT_THROW(robust.add_property({"p", "exists[x]. {id: *x}"}), SpecError);
 }
 
 // ---------------------------------------------------------------- Boolean

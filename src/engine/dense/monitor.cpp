@@ -58,6 +58,9 @@ const Signal& Monitor::step(double begin, double end, const uint8_t* atoms) {
       case Code::Once: once_[state_[i]].update(signal_[in.a], end, out); break;
       case Code::Historically: historically_[state_[i]].update(signal_[in.a], end, out); break;
       case Code::Since: since_[state_[i]].update(signal_[in.a], signal_[in.b], end, out); break;
+      case Code::Bind:  // data references run in data::DenseMonitor, never here
+      case Code::Exists:
+      case Code::Forall: out.constant(begin, false); break;
     }
   }
   return signal_[n - 1];

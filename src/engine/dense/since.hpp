@@ -10,6 +10,10 @@
 //            right end w (φ may hold from there on): [w+a, w+b).
 // The result does not depend on how messages cut time: a message that
 // changes nothing changes no verdict (Reelay 25 differs; docs/semantics.md).
+//
+// `right_suffices`: ψ holding on a piece makes the output true there even
+// while φ is false (s = t in "ψ at s, φ on (s, t]"). Reelay 25's dense data
+// monitors read `since` written without bounds so; its plain ones do not.
 #pragma once
 
 #include "engine/dense/signal.hpp"
@@ -20,6 +24,7 @@ namespace rvc::engine::dense {
 
 struct Since {
   double lo = 0, hi = spec::kInfinity;
+  bool right_suffices = false;
   IntervalQueue<double> candidates;
 
   void update(const Signal& left, const Signal& right, double end, Signal& out) {
@@ -30,7 +35,7 @@ struct Since {
       const Cut& c = cuts_[k];
       double until = k + 1 < cuts_.size() ? cuts_[k + 1].t : end;
       if (c.t >= until) continue;
-      out.set(c.t, false);
+      out.set(c.t, right_suffices && !c.left && c.right);
       if (!c.left) {
         candidates.clear();
         if (c.right) candidates.add(until + lo, until + hi, 0);

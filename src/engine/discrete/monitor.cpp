@@ -130,7 +130,10 @@ void Monitor::why(const Property& p, size_t i, Step at, std::vector<std::string>
   switch (in.code) {
     case Code::Atom: out.push_back(text + " is " + word(v) + " at step " + std::to_string(at)); return;
     case Code::True:
-    case Code::False: return;
+    case Code::False:
+    case Code::Bind:  // data references run in data::DiscreteMonitor, never here
+    case Code::Exists:
+    case Code::Forall: return;
     case Code::Not: why(p, a, at, out); return;
     case Code::And:
       if (v) {

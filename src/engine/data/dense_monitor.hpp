@@ -1,0 +1,44 @@
+// Dense-time monitor of one property with data references: the dense
+// counterpart of DiscreteMonitor. Each sub-formula is a table of signals
+// over the current segment [begin, end), one per assignment of its free
+// variables; each temporal operator a table of the plain dense operators'
+// states. Quantifiers fold a table's signals into one (union for exists,
+// intersection for forall), change points included.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "engine/data/tables.hpp"
+#include "engine/dense/historically.hpp"
+#include "engine/dense/once.hpp"
+#include "engine/dense/signal.hpp"
+#include "engine/dense/since.hpp"
+#include "engine/program.hpp"
+
+namespace rvc::engine::data {
+
+class DenseMonitor {
+ public:
+  DenseMonitor(const Program& program, const std::string& property, uint32_t max_values);
+
+  // The atoms' values (and bound values' ids) held over [begin, end); returns
+  // the property's value over it. Throws DataLimitError past max_values.
+  const dense::Signal& step(double begin, double end, const uint8_t* atoms, const uint32_t* bound);
+
+ private:
+  template <class F>
+  void each_table(F&& f);
+
+  std::vector<Instr> code_;
+  Bindings bindings_;
+  std::vector<Table<dense::Signal>> signal_;  // per instruction
+  std::vector<int32_t> state_;
+  std::vector<Table<dense::Once>> once_;
+  std::vector<Table<dense::Historically>> historically_;
+  std::vector<Table<dense::Since>> since_;
+  dense::Signal scratch_;
+};
+
+}  // namespace rvc::engine::data

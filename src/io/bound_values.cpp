@@ -1,0 +1,29 @@
+#include "io/bound_values.hpp"
+
+#include <charconv>
+
+namespace rvc::io {
+
+uint32_t BoundValues::id(const FieldValue& v) {
+  key_.clear();
+  switch (v.kind) {
+    case ValueKind::String:
+      key_.push_back('s');
+      key_.append(v.s);
+      break;
+    case ValueKind::Number: {
+      char buf[32];
+      const double d = v.d == 0 ? 0.0 : v.d;  // -0 is 0
+      const auto written = std::to_chars(buf, buf + sizeof buf, d);  // shortest exact text: one key per double
+      key_.push_back('n');
+      key_.append(buf, written.ptr);
+      break;
+    }
+    case ValueKind::Bool: key_ = v.b ? "b1" : "b0"; break;
+    default: return 0;
+  }
+  auto [it, added] = ids_.try_emplace(key_, static_cast<uint32_t>(ids_.size() + 1));
+  return it->second;
+}
+
+}  // namespace rvc::io
