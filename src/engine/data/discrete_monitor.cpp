@@ -13,6 +13,7 @@ DiscreteMonitor::DiscreteMonitor(const Program& program, const std::string& prop
     : code_(program.code),
       bindings_(program, property, max_values),
       value_(program.code.size()),
+      set_(program.code.size(), 0),
       state_(program.code.size(), -1) {
   const std::vector<Mask> mask = free_variables(program);
   const Domains& domains = bindings_.domains();
@@ -86,9 +87,14 @@ bool DiscreteMonitor::step(const uint8_t* atoms, const uint32_t* bound) {
       case Code::True: r[0] = 1; break;
       case Code::False: r[0] = 0; break;
       case Code::Atom: r[0] = atoms[in.atom] != 0; break;
-      case Code::Bind: {
-        domains.for_each<1>(out.mask, {out.strides}, [&](const std::array<size_t, 1>& o) { r[o[0]] = 0; });
-        if (const uint32_t k = bindings_.index(i)) r[k * out.strides.of[static_cast<size_t>(in.var)]] = 1;
+      case Code::Bind: {  // one entry true at most: move it (O(1), not a pass over the table)
+        const size_t stride = out.strides.of[static_cast<size_t>(in.var)];
+        const uint32_t k = bindings_.index(i);
+        if (set_[i] != k) {
+          if (set_[i]) r[set_[i] * stride] = 0;
+          if (k) r[k * stride] = 1;
+          set_[i] = k;
+        }
         break;
       }
       case Code::Not: unary([](uint8_t x) { return static_cast<uint8_t>(!x); }); break;

@@ -45,6 +45,7 @@ class DiscreteMonitor {
   std::vector<Instr> code_;
   Bindings bindings_;
   std::vector<Table<uint8_t>> value_;   // per instruction
+  std::vector<uint32_t> set_;           // per Bind instruction: the index its table holds true, 0 none
   std::vector<int32_t> state_;          // per instruction: its table in the vector of its kind
   std::vector<Table<discrete::Pre>> pre_;
   std::vector<Table<discrete::Once>> once_;
