@@ -25,7 +25,20 @@ Bindings::Bindings(const Program& program, const std::string& property, uint32_t
       max_values_(max_values),
       domains_(program.variables.size()),
       value_index_(program.variables.size()),
-      index_of_instr_(program.code.size(), 0) {}
+      index_of_instr_(program.code.size(), 0),
+      masks_(free_variables(program)) {}
+
+void Bindings::check_size(const Domains& before) {
+  for (Mask m : masks_) {
+    if (domains_.capacity(m) <= kMaxEntries) continue;
+    domains_ = before;
+    std::string vars;
+    for (size_t v = 0; v < variables_.size(); ++v)
+      if (m & bit(static_cast<int>(v))) vars += (vars.empty() ? "" : ", ") + variables_[v];
+    throw DataLimitError("property '" + property_ + "': a sub-formula over variables " + vars + " would need more than " +
+                         std::to_string(kMaxEntries) + " entries (one per combination of their values seen)");
+  }
+}
 
 void Bindings::check_limit(int var) const {
   if (domains_.size(var) - 1 < max_values_) return;

@@ -39,7 +39,7 @@ struct Strides {
 
 class Domains {
  public:
-  explicit Domains(size_t variables) : size_(variables, 1), capacity_(variables, 4) {}
+  explicit Domains(size_t variables) : size_(variables, 1), capacity_(variables, 1) {}
 
   size_t variables() const { return size_.size(); }
   uint32_t size(int v) const { return size_[static_cast<size_t>(v)]; }  // live indexes, "other" included
@@ -188,6 +188,7 @@ class Bindings {
         check_limit(in.var);
         const Domains before = domains_;
         const bool grew = domains_.add(in.var);
+        if (grew) check_size(before);
         index.set(value, domains_.size(in.var) - 1);
         grow(in.var, domains_.size(in.var) - 1, grew ? &before : nullptr);
       }
@@ -197,6 +198,11 @@ class Bindings {
 
  private:
   void check_limit(int var) const;
+  void check_size(const Domains& before);  // restores `before` and throws past kMaxEntries
+
+  // The most entries one table may have: a sub-formula over several
+  // variables takes the product of their values.
+  static constexpr size_t kMaxEntries = size_t{1} << 24;
 
   std::vector<Instr> code_;
   std::vector<std::string> variables_;
@@ -205,6 +211,7 @@ class Bindings {
   Domains domains_;
   std::vector<ValueIndex> value_index_;  // per variable
   std::vector<uint32_t> index_of_instr_;
+  std::vector<Mask> masks_;  // of the tables (free variables of each sub-formula)
 };
 
 // Makes room in `table` for variable var's new index (Bindings::update).
