@@ -36,9 +36,14 @@ def formula(rng, depth, dense):
     if depth == 0 or rng.random() < 0.2:
         return rng.choice(ATOMS)
     choice = rng.choice(["not", "pre", "once", "hist", "and", "or", "implies", "since", "since"])
+    return operator(rng, choice, lambda: formula(rng, depth - 1, dense), dense)
+
+
+def operator(rng, choice, sub, dense):
+    """The operator `choice` (not, pre, once, hist, since, and, or, implies) over formulas from
+    sub(); random bounds. Dense time has no pre: once instead."""
     if dense and choice == "pre":
         choice = "once"
-    sub = lambda: formula(rng, depth - 1, dense)
     if choice == "not":
         return f"not ({sub()})"
     if choice == "pre":

@@ -21,14 +21,13 @@ import json
 import os
 import random
 import re
-import subprocess
 
 import pytest
 
 reelay = pytest.importorskip("reelay")
 
-from randspec import bounds, write_jsonl
-from test_reelay_differential import condense, describe, with_heartbeats
+from randspec import operator
+from test_reelay_differential import condense, describe, run_rvc, with_heartbeats
 
 CASES = int(os.environ.get("RVC_DIFF_CASES", "60"))
 FORMULAS_PER_CASE = 10
@@ -44,28 +43,14 @@ def data_formula(rng, depth, scope, fresh, dense=False):
             return rng.choice([f"{{id: *{v}}}", f"{{o: *{v}}}", f"{{id: *{v}, p}}", f"{{o: *{v}, x > 1}}"])
         return rng.choice(PLAIN)
     choice = rng.choice(["not", "pre", "once", "hist", "and", "or", "implies", "since", "quant", "quant"])
-    if dense and choice == "pre":
-        choice = "once"
-    sub = lambda: data_formula(rng, depth - 1, scope, fresh, dense)
     if choice == "quant" and fresh:
         v = fresh[0]
         body = data_formula(rng, depth - 1, scope + [v], fresh[1:], dense)
         if not re.search(rf"\*{v}\b", body):  # Reelay crashes on a variable its body never binds
             body = f"({body}) {rng.choice(['and', 'or', 'implies'])} ({{id: *{v}}})"
         return f"({rng.choice(['exists', 'forall'])}[{v}]. ({body}))"
-    if choice == "not":
-        return f"not ({sub()})"
-    if choice == "pre":
-        return f"pre ({sub()})"
-    if choice == "once":
-        return f"once{bounds(rng, dense)} ({sub()})"
-    if choice == "hist":
-        return f"historically{bounds(rng, dense)} ({sub()})"
-    if choice == "since":
-        return f"({sub()}) since{bounds(rng, dense)} ({sub()})"
-    if choice == "quant":
-        return f"not ({sub()})"
-    return f"({sub()}) {choice} ({sub()})"
+    return operator(rng, "not" if choice == "quant" else choice,
+                    lambda: data_formula(rng, depth - 1, scope, fresh, dense), dense)
 
 
 def closed_formula(rng, dense=False):
@@ -118,27 +103,12 @@ def data_trace(rng, length, dense=False):
     return events
 
 
-def run_rvc(rvc, tmp_path, formulas, events, dense=False):
-    props = tmp_path / "props.json"
-    props.write_text(json.dumps({"properties": [{"name": f"f{i}", "spec": f} for i, f in enumerate(formulas)]}))
-    tr = tmp_path / "trace.jsonl"
-    write_jsonl(tr, events)
-    proc = subprocess.run([rvc, "check", "--dense" if dense else "--all", "--properties", str(props), str(tr)],
-                          capture_output=True, text=True)
-    assert proc.returncode in (0, 1), f"rvc failed ({proc.returncode}): {proc.stderr}"
-    out = {f"f{i}": [] for i in range(len(formulas))}
-    for line in proc.stdout.splitlines():
-        v = json.loads(line)
-        out[v["property"]].append((v["time"], v["value"]))
-    return out
-
-
 @pytest.mark.parametrize("seed", range(CASES))
 def test_data_references_match_reelay(rvc, tmp_path, seed):
     rng = random.Random(9000 + seed)
     formulas = [closed_formula(rng) for _ in range(FORMULAS_PER_CASE)]
     events = data_trace(rng, rng.randint(15, 50))
-    ours = run_rvc(rvc, tmp_path, formulas, events)
+    ours = run_rvc(rvc, tmp_path, formulas, events, dense=False)
     for i, f in enumerate(formulas):
         m = reelay.discrete_timed_monitor(pattern=for_reelay(f), condense=False)
         theirs = [(step, bool(m.update(dict(e))["value"])) for step, e in enumerate(events)]
