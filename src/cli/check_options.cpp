@@ -11,7 +11,7 @@ void CheckOptions::add_to(CLI::App& app) {
   app.add_flag("--all", all, "Report the verdict at every step, not only changes");
   app.add_flag("--robustness", robustness,
                "Report robustness values (Reelay's quantitative semantics: how far from changing the verdict; "
-               "positive holds) instead of true/false; discrete time, JSON input (docs/semantics.md)");
+               "positive holds) instead of true/false; JSON input (docs/semantics.md)");
   app.add_flag("--explain", explain,
                "With each violation, say why: the sub-formulas and steps that made the verdict false (discrete time)");
   app.add_option("--max-data-values", max_data_values,

@@ -12,8 +12,6 @@ Checker::Checker(TimeModel model, bool emit_all, VerdictCallback on_verdict)
     : model_(model), emit_all_(emit_all), on_verdict_(std::move(on_verdict)) {}
 
 void Checker::enable_robustness() {
-  if (model_ != TimeModel::Discrete)
-    throw std::invalid_argument("--robustness works in discrete time for now (not with --dense)");
   if (!names_.empty()) throw std::logic_error("enable_robustness after add_property");
   robustness_ = true;
 }
@@ -39,6 +37,15 @@ void Checker::add_property(const PropertySpec& property) {
       data_.emplace_back(program, property.name, max_data_values_);
       where_.emplace_back(kData, static_cast<uint32_t>(data_.size() - 1));
     }
+    names_.push_back(property.name);
+    last_.push_back(-1);
+    return;
+  }
+  if (robustness_ && model_ == TimeModel::Dense) {
+    if (std::string why = robust::DenseMonitor::unsupported(program); !why.empty())
+      throw spec::SpecError(why, property.spec, 1);
+    robust_dense_.emplace_back(program);
+    last_robustness_.push_back(std::numeric_limits<double>::quiet_NaN());
     names_.push_back(property.name);
     last_.push_back(-1);
     return;
@@ -105,6 +112,19 @@ void Checker::step_robust(const double* margins) {
     const bool holds = r > 0;  // 0 is not a margin: a false Boolean field is 0
     if (!holds) ++violations_;
     if (on_verdict_) on_verdict_(Verdict{names_[i], now, holds, true, r});
+  }
+}
+
+void Checker::step_robust(double begin, double end, const double* margins) {
+  if (!(begin < end)) return;
+  for (size_t i = 0; i < robust_dense_.size(); ++i) {
+    for (const robust::RealPiece& p : robust_dense_[i].step(begin, end, margins).pieces) {
+      if (p.v == last_robustness_[i]) continue;  // changes only, as for Booleans in dense time
+      last_robustness_[i] = p.v;
+      const bool holds = p.v > 0;
+      if (!holds) ++violations_;
+      if (on_verdict_) on_verdict_(Verdict{names_[i], p.t, holds, true, p.v});
+    }
   }
 }
 

@@ -17,6 +17,7 @@
 #include "engine/dense/monitor.hpp"
 #include "engine/discrete/monitor.hpp"
 #include "engine/program.hpp"
+#include "engine/robust/dense_monitor.hpp"
 #include "engine/robust/monitor.hpp"
 
 namespace rvc::engine {
@@ -41,8 +42,8 @@ class Checker {
  public:
   Checker(TimeModel model, bool emit_all, VerdictCallback on_verdict);
 
-  // Robustness (quantitative) semantics instead of Boolean verdicts, in
-  // discrete time: call before add_property; step_robust() then drives it.
+  // Robustness (quantitative) semantics instead of Boolean verdicts: call
+  // before add_property; step_robust() then drives it.
   void enable_robustness();
   // --explain: each violation's verdict carries why (discrete time).
   void enable_explain();
@@ -67,6 +68,8 @@ class Checker {
   void step(const uint8_t* atoms, const uint32_t* bound = nullptr);
   // Robustness, discrete time: one step with the atoms' margins.
   void step_robust(const double* margins);
+  // Robustness, dense time: the atoms' margins held over [begin, end).
+  void step_robust(double begin, double end, const double* margins);
   // Dense time: the atoms' values held over [begin, end).
   void step(double begin, double end, const uint8_t* atoms, const uint32_t* bound = nullptr);
 
@@ -94,6 +97,7 @@ class Checker {
   bool robustness_ = false;
   bool explain_ = false;
   std::vector<robust::Monitor> robust_;
+  std::vector<robust::DenseMonitor> robust_dense_;
   std::vector<double> last_robustness_;
   int64_t now_robust_ = 0;
   int64_t now_discrete_ = 0;

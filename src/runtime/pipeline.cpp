@@ -141,7 +141,7 @@ void Pipeline::commit() {
     hook_(values(), t, pending_where_->number());
   } else if (options_.parse_only) {
     commit_values();
-  } else if (checker_.robustness()) {
+  } else if (checker_.robustness() && checker_.model() == engine::TimeModel::Discrete) {
     commit_values();
     checker_.step_robust(decoder_.margins());
   } else if (checker_.model() == engine::TimeModel::Discrete) {
@@ -158,7 +158,8 @@ void Pipeline::commit() {
       on_error(io::LineError{pending_where_->number(), 0, why});
       return;
     }
-    checker_.step(begin, t, values(), bound());
+    if (checker_.robustness()) checker_.step_robust(begin, t, decoder_.margins());
+    else checker_.step(begin, t, values(), bound());
     commit_values();
     has_time_ = true;
     last_time_ = t;

@@ -1,5 +1,5 @@
 """rvc --robustness equals Reelay 25's robustness semantics (PyPI `reelay`,
-`semantics="robustness"`) at every step, discrete time.
+`semantics="robustness"`) at every step in discrete time, at every change in dense time.
 
 Random formulas over numeric and Boolean fields ({x > 2}: x - 2, {p}: 1 or 0,
 {p: false}: +-inf, ...) and every operator rvc evaluates for robustness
@@ -7,7 +7,8 @@ Random formulas over numeric and Boolean fields ({x > 2}: x - 2, {p}: 1 or 0,
 unbounded since); random traces where fields go missing (they hold) and an
 extra real-valued field y. Values compared exactly: both sides compute them
 with the same min, max, negation and subtraction. One `rvc check --all` run
-per case checks all its formulas.
+per case checks all its formulas. Dense time: formulas without since
+(refused there for now) over the same atoms, as test_dense_robustness_matches_reelay says.
 """
 import json
 import math
@@ -94,9 +95,61 @@ def test_what_robustness_refuses(rvc, tmp_path):
     write_jsonl(tr, [{"time": 0, "x": 1}])
     cases = [
         (["--spec", "{x > 1} since[1:3] {x < 0}"], "since with time bounds has no robustness semantics in rvc yet"),
-        (["--spec", "{x > 1}", "--dense"], "--robustness works in discrete time for now"),
+        (["--spec", "{x > 1} since {x < 0}", "--dense"], "since has no dense-time robustness in rvc yet"),
     ]
     for extra, message in cases:
         proc = subprocess.run([rvc, "check", "--robustness", *extra, str(tr)], capture_output=True, text=True)
         assert proc.returncode == 2, proc.stderr
         assert message in proc.stderr, proc.stderr
+
+
+def dense_robust_formula(rng, depth):
+    """A dense randspec formula without since (no dense robustness for it in rvc yet), with more
+    numeric atoms; no {x == c} or {x != c}, which Reelay's dense robustness monitors refuse."""
+    while True:
+        f = formula(rng, depth, dense=True)
+        if "since" not in f:
+            break
+    for atom in ("{r}", "{x > 2}"):
+        if atom in f and rng.random() < 0.7:
+            f = f.replace(atom, rng.choice([a for a in NUMERIC if "!=" not in a and "==" not in a]), 1)
+    return f
+
+
+def leading_zero_dropped(changes):
+    """Reelay's dense robustness monitors start from 0 and report changes from it; rvc reports
+    the first value whatever it is."""
+    return changes[1:] if changes and changes[0][1] == 0 else changes
+
+
+@pytest.mark.parametrize("seed", range(CASES))
+def test_dense_robustness_matches_reelay(rvc, tmp_path, seed):
+    """Dense time: every change of the robustness signal, at the same times with the same values.
+    Compared as the Boolean dense test compares (test_reelay_differential.py): Reelay on the trace
+    with heartbeats (empty messages changing nothing), where every change point is a message."""
+    from test_reelay_differential import condense, with_heartbeats
+    rng = random.Random(8000 + seed)
+    formulas = [dense_robust_formula(rng, rng.randint(1, 4)) for _ in range(FORMULAS_PER_CASE)]
+    events = trace(rng, rng.randint(10, 40), dense=True)
+    for e in events:
+        if rng.random() < 0.8:
+            e["y"] = rng.choice([-2.5, -1.25, -0.5, 0, 0.25, 0.5, 1.75, 3])
+    props = tmp_path / "props.json"
+    props.write_text(json.dumps({"properties": [{"name": f"f{i}", "spec": f} for i, f in enumerate(formulas)]}))
+    tr = tmp_path / "trace.jsonl"
+    write_jsonl(tr, events)
+    proc = subprocess.run([rvc, "check", "--dense", "--robustness", "--properties", str(props), str(tr)],
+                          capture_output=True, text=True)
+    assert proc.returncode in (0, 1), f"rvc failed ({proc.returncode}): {proc.stderr}"
+    ours = {f"f{i}": [] for i in range(len(formulas))}
+    for line in proc.stdout.splitlines():
+        v = json.loads(line)
+        ours[v["property"]].append((v["time"], value(v["value"])))
+    probed = with_heartbeats(events)
+    for i, f in enumerate(formulas):
+        m = reelay.dense_timed_monitor(pattern=f, semantics="robustness")
+        theirs = []
+        for e in probed:
+            theirs += [(r["time"], float(r["value"])) for r in m.update(dict(e))]
+        assert leading_zero_dropped(condense(ours[f"f{i}"])) == leading_zero_dropped(condense(theirs)), (
+            f"formula: {f}\nrvc:    {ours[f'f{i}']}\nreelay: {condense(theirs)}\ntrace: {json.dumps(events)}")

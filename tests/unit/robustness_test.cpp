@@ -62,8 +62,34 @@ TEST(RobustChecker, BoundedSinceIsRefusedWithItsReason) {
   Checker checker(TimeModel::Discrete, false, nullptr);
   checker.enable_robustness();
   EXPECT_THROW(checker.add_property({"p", "{x > 1} since[0:2] {y > 1}"}), spec::SpecError);
-  Checker dense(TimeModel::Dense, false, nullptr);
-  EXPECT_THROW(dense.enable_robustness(), std::invalid_argument);
+}
+
+// Dense time: x = 1 on [0, 1), 3 on [1, 2.5), 0 on [2.5, 3), 5 on [3, 6), 2 on [6, 7); the
+// margins of {x > 2} are -1, 1, -2, 3, 0. Windows are closed, pieces right-open; values worked
+// out by hand (and equal to Reelay 25's).
+TEST(RobustDense, WindowsOverPiecesByHand) {
+  const std::pair<double, double> pieces[] = {{0, -1}, {1, 1}, {2.5, -2}, {3, 3}, {6, 0}};
+  const auto run = [&](const std::string& spec) {
+    std::vector<std::pair<double, double>> out;
+    Checker c(TimeModel::Dense, false, [&](const Verdict& v) { out.emplace_back(v.time, v.robustness); });
+    c.enable_robustness();
+    c.add_property({"p", spec});
+    for (size_t i = 0; i < std::size(pieces); ++i) {
+      const double margin = pieces[i].second;
+      c.step_robust(pieces[i].first, i + 1 < std::size(pieces) ? pieces[i + 1].first : 7.0, &margin);
+    }
+    return out;
+  };
+  using V = std::vector<std::pair<double, double>>;
+  const double inf = std::numeric_limits<double>::infinity();
+  EXPECT_EQ(run("once{x > 2}"), (V{{0, -1}, {1, 1}, {3, 3}}));
+  EXPECT_EQ(run("once[1:2]{x > 2}"), (V{{0, -inf}, {1, -1}, {2, 1}, {4, 3}}));
+  EXPECT_EQ(run("historically[0:1]{x > 2}"), (V{{0, -1}, {2, 1}, {2.5, -2}, {4, 3}, {6, 0}}));
+  EXPECT_EQ(run("historically[1:2]{x > 2}"), (V{{0, inf}, {1, -1}, {3, 1}, {3.5, -2}, {5, 3}}));
+  EXPECT_EQ(run("not once[0.5:]{x > 2}"), (V{{0, inf}, {0.5, 1}, {1.5, -1}, {3.5, -3}}));
+  Checker refuses(TimeModel::Dense, false, nullptr);
+  refuses.enable_robustness();
+  EXPECT_THROW(refuses.add_property({"p", "{x > 2} since {x < 1}"}), spec::SpecError);
 }
 
 }  // namespace

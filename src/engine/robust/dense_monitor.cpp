@@ -1,0 +1,62 @@
+#include "engine/robust/dense_monitor.hpp"
+
+#include <algorithm>
+#include <limits>
+#include <stdexcept>
+
+namespace rvc::engine::robust {
+
+std::string DenseMonitor::unsupported(const Program& program) {
+  for (const Instr& in : program.code)
+    if (in.code == Code::Since)
+      return "since has no dense-time robustness in rvc yet (once, historically, with or without bounds, do)";
+  return "";
+}
+
+DenseMonitor::DenseMonitor(const Program& program)
+    : code_(program.code), signal_(program.code.size()), state_(program.code.size(), -1) {
+  if (std::string why = unsupported(program); !why.empty()) throw std::invalid_argument(why);
+  for (size_t i = 0; i < code_.size(); ++i) {
+    const Instr& in = code_[i];
+    if (in.code != Code::Once && in.code != Code::Historically) continue;
+    state_[i] = static_cast<int32_t>(window_.size());
+    window_.emplace_back(in.bounds.lo, in.bounds.hi, in.code == Code::Once ? 1.0 : -1.0);
+  }
+}
+
+const RealSignal& DenseMonitor::step(double begin, double end, const double* margins) {
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  for (size_t i = 0; i < code_.size(); ++i) {
+    const Instr& in = code_[i];
+    RealSignal& out = signal_[i];
+    const auto binary = [&](auto&& f) {
+      out.clear();
+      zip(signal_[static_cast<size_t>(in.a)], signal_[static_cast<size_t>(in.b)],
+          [&](double t, double l, double r) { out.set(t, f(l, r)); });
+    };
+    switch (in.code) {
+      case Code::True: out.constant(begin, kInf); break;
+      case Code::False: out.constant(begin, -kInf); break;
+      case Code::Atom: out.constant(begin, margins[in.atom]); break;
+      case Code::Not:
+        out.clear();
+        for (const RealPiece& p : signal_[static_cast<size_t>(in.a)].pieces) out.set(p.t, -p.v);
+        break;
+      case Code::And: binary([](double l, double r) { return std::min(l, r); }); break;
+      case Code::Or: binary([](double l, double r) { return std::max(l, r); }); break;
+      case Code::Implies: binary([](double l, double r) { return std::max(-l, r); }); break;
+      case Code::Once:
+      case Code::Historically:
+        window_[static_cast<size_t>(state_[i])].update(signal_[static_cast<size_t>(in.a)], end, out);
+        break;
+      case Code::Pre:  // refused by the compiler in dense time
+      case Code::Since:  // refused (unsupported)
+      case Code::Bind:   // refused by the Checker
+      case Code::Exists:
+      case Code::Forall: out.constant(begin, -kInf); break;
+    }
+  }
+  return signal_.back();
+}
+
+}  // namespace rvc::engine::robust
