@@ -223,13 +223,14 @@ io::JsonObject verdict_object(const Row& v) {  // id, property, time, value, wal
       .add_raw("wall", json_wall(v[4]));
 }
 
-io::JsonObject violation_object(const Row& v) {  // id, property, time, wall, witness
+io::JsonObject violation_object(const Row& v) {  // id, property, time, wall, witness, explanation
   return io::JsonObject()
       .add_raw("id", json_number(v[0]))
       .add("property", v[1])
       .add_raw("time", json_number(v[2]))
       .add_raw("wall", json_wall(v[3]))
-      .add_raw("witness", embedded_json(v[4]));
+      .add_raw("witness", embedded_json(v[4]))
+      .add_raw("explanation", embedded_json(v[5]));  // null without --explain
 }
 
 // Rows of `table` after id `after` (in id order), at most `limit`.
@@ -247,7 +248,7 @@ QueryResult rows_after(Database& db, const char* columns, const char* table, con
 }
 
 const char* const kVerdictColumns = "id, property, time, value, wall";
-const char* const kViolationColumns = "id, property, time, wall, witness";
+const char* const kViolationColumns = "id, property, time, wall, witness, explanation";
 const char* const kCounterColumns = "id, wall, counters";
 
 // A page of rows: {"run":..,"after":..,"<key>":[..],"last_id":..,"more":..}.

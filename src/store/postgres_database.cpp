@@ -152,6 +152,8 @@ class PostgresDatabase final : public Database {
     // advisory lock makes a second rvc wait for the first.
     std::string sql = "BEGIN; SELECT pg_advisory_xact_lock(" + std::to_string(kSchemaLock) + ");";
     for (const auto& statement : schema_statements(Dialect::Postgres)) sql += statement + ";";
+    for (const AddedColumn& c : added_columns())
+      sql += std::string("ALTER TABLE ") + c.table + " ADD COLUMN IF NOT EXISTS " + c.column + " " + c.type + ";";
     sql += "COMMIT";
     transaction([&] { exec(sql, "schema"); });
   }

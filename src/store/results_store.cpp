@@ -158,7 +158,8 @@ std::string ResultsStore::witness_json() const {
   return out.str();
 }
 
-void ResultsStore::on_verdict(const std::string& property, double time, bool value) {
+void ResultsStore::on_verdict(const std::string& property, double time, bool value,
+                              const std::vector<std::string>* explanation) {
   auto [it, first] = last_value_.try_emplace(property, value ? 1 : 0);
   if (!first && it->second == (value ? 1 : 0)) return;
   it->second = value ? 1 : 0;
@@ -177,6 +178,15 @@ void ResultsStore::on_verdict(const std::string& property, double time, bool val
     violation.run = run_;
     violation.text[0] = property;
     violation.text[1] = witness_json();
+    if (explanation) {
+      io::JsonArray sentences;
+      for (const std::string& sentence : *explanation) {
+        std::string quoted;
+        io::append_json_string(quoted, sentence);
+        sentences.add_raw(quoted);
+      }
+      violation.text[2] = sentences.str();
+    }
     violation.number[0] = time;
     violation.number[1] = wall;
     push(std::move(violation));

@@ -71,7 +71,9 @@ class ResultsStore {
   void on_message(std::string_view input, std::string_view payload, uint64_t position);
   // A verdict: stored if it changes the property's value; a change to false
   // is also a violation, stored with the witness window.
-  void on_verdict(const std::string& property, double time, bool value);
+  // `explanation`: --explain's sentences for a violation's start (else null).
+  void on_verdict(const std::string& property, double time, bool value,
+                  const std::vector<std::string>* explanation = nullptr);
   // A counters snapshot (JSON object).
   void on_counters(std::string_view counters_json);
   // The run ended: final counters, exit status. Then waits for the writer to

@@ -14,7 +14,8 @@ enum class Table : uint8_t {
   Run,        // run: text0 command line, text1 inputs (JSON array), text2 time model; number0 started_at
   Property,   // run: text0 name, text1 spec
   Verdict,    // run: text0 property; number0 time, number1 wall clock; integer value (0/1). Changes only.
-  Violation,  // run: text0 property, text1 witness (JSON array); number0 time, number1 wall clock
+  Violation,  // run: text0 property, text1 witness (JSON array), text2 explanation (JSON array or "");
+              // number0 time, number1 wall clock
   Counters,   // run: text0 counters (JSON object); number1 wall clock
   RunEnd,     // run: text0 end reason, text1 final counters (JSON); number1 ended_at; integer exit status
 };

@@ -20,12 +20,14 @@ std::vector<std::string> schema_statements(Dialect dialect) {
           ", value INTEGER, wall " + real + ")",
       "CREATE INDEX IF NOT EXISTS verdicts_by_run ON verdicts (run, property, id)",
       "CREATE TABLE IF NOT EXISTS violations (" + id + ", run TEXT NOT NULL, property TEXT NOT NULL, time " + real +
-          ", wall " + real + ", witness TEXT)",
+          ", wall " + real + ", witness TEXT, explanation TEXT)",
       "CREATE INDEX IF NOT EXISTS violations_by_run ON violations (run, id)",
       "CREATE TABLE IF NOT EXISTS counters (" + id + ", run TEXT NOT NULL, wall " + real + ", counters TEXT)",
       "CREATE INDEX IF NOT EXISTS counters_by_run ON counters (run, id)",
   };
 }
+
+std::vector<AddedColumn> added_columns() { return {{"violations", "explanation", "TEXT"}}; }
 
 const char* insert_statement(Table table) {
   switch (table) {
@@ -37,7 +39,7 @@ const char* insert_statement(Table table) {
     case Table::Verdict:
       return "INSERT INTO verdicts (run, property, time, value, wall) VALUES (?, ?, ?, ?, ?)";
     case Table::Violation:
-      return "INSERT INTO violations (run, property, time, wall, witness) VALUES (?, ?, ?, ?, ?)";
+      return "INSERT INTO violations (run, property, time, wall, witness, explanation) VALUES (?, ?, ?, ?, ?, ?)";
     case Table::Counters:
       return "INSERT INTO counters (run, wall, counters) VALUES (?, ?, ?)";
     case Table::RunEnd:
@@ -63,7 +65,7 @@ std::vector<std::string> insert_values(const Row& r) {
     case Table::Run: return {r.run, r.text[0], r.text[1], r.text[2], num(r.number[0])};
     case Table::Property: return {r.run, r.text[0], r.text[1]};
     case Table::Verdict: return {r.run, r.text[0], num(r.number[0]), std::to_string(r.integer), num(r.number[1])};
-    case Table::Violation: return {r.run, r.text[0], num(r.number[0]), num(r.number[1]), r.text[1]};
+    case Table::Violation: return {r.run, r.text[0], num(r.number[0]), num(r.number[1]), r.text[1], r.text[2]};
     case Table::Counters: return {r.run, num(r.number[1]), r.text[0]};
     case Table::RunEnd: return {r.text[0], r.text[1], num(r.number[1]), std::to_string(r.integer), r.run};
   }

@@ -33,6 +33,9 @@ class SqliteDatabase final : public Database {
 
   void ensure_schema() override {
     for (const auto& sql : schema_statements(Dialect::Sqlite)) exec(sql);
+    for (const AddedColumn& c : added_columns())
+      if (!has_column(c.table, c.column))
+        exec(std::string("ALTER TABLE ") + c.table + " ADD COLUMN " + c.column + " " + c.type);
   }
 
   void write(const std::vector<Row>& rows) override {
@@ -94,7 +97,9 @@ class SqliteDatabase final : public Database {
       case Table::Run: text(r.run), text(r.text[0]), text(r.text[1]), text(r.text[2]), real(r.number[0]); break;
       case Table::Property: text(r.run), text(r.text[0]), text(r.text[1]); break;
       case Table::Verdict: text(r.run), text(r.text[0]), real(r.number[0]), integer(r.integer), real(r.number[1]); break;
-      case Table::Violation: text(r.run), text(r.text[0]), real(r.number[0]), real(r.number[1]), text(r.text[1]); break;
+      case Table::Violation:
+        text(r.run), text(r.text[0]), real(r.number[0]), real(r.number[1]), text(r.text[1]), text(r.text[2]);
+        break;
       case Table::Counters: text(r.run), real(r.number[1]), text(r.text[0]); break;
       case Table::RunEnd: text(r.text[0]), text(r.text[1]), real(r.number[1]), integer(r.integer), text(r.run); break;
     }
@@ -115,6 +120,17 @@ class SqliteDatabase final : public Database {
       DbError e = error("");
       throw DbError(describe() + ": " + what + " (in: " + sql + ")", e.connection_lost());
     }
+  }
+  // SQLite has no ADD COLUMN IF NOT EXISTS.
+  bool has_column(const std::string& table, const std::string& column) {
+    sqlite3_stmt* stmt = nullptr;
+    if (sqlite3_prepare_v2(db_, ("PRAGMA table_info(" + table + ")").c_str(), -1, &stmt, nullptr) != SQLITE_OK)
+      throw error("table_info");
+    bool found = false;
+    while (sqlite3_step(stmt) == SQLITE_ROW)
+      found = found || column == reinterpret_cast<const char*>(sqlite3_column_text(stmt, 1));
+    sqlite3_finalize(stmt);
+    return found;
   }
   sqlite3_stmt* insert(Table table) {
     auto& stmt = inserts_[table];

@@ -37,7 +37,7 @@ SCHEMA = [
     "property TEXT NOT NULL, time DOUBLE PRECISION, value INTEGER, wall DOUBLE PRECISION)",
     "CREATE INDEX IF NOT EXISTS verdicts_by_run ON verdicts (run, property, id)",
     "CREATE TABLE IF NOT EXISTS violations (id INTEGER PRIMARY KEY AUTOINCREMENT, run TEXT NOT NULL, "
-    "property TEXT NOT NULL, time DOUBLE PRECISION, wall DOUBLE PRECISION, witness TEXT)",
+    "property TEXT NOT NULL, time DOUBLE PRECISION, wall DOUBLE PRECISION, witness TEXT, explanation TEXT)",
     "CREATE INDEX IF NOT EXISTS violations_by_run ON violations (run, id)",
     "CREATE TABLE IF NOT EXISTS counters (id INTEGER PRIMARY KEY AUTOINCREMENT, run TEXT NOT NULL, "
     "wall DOUBLE PRECISION, counters TEXT)",
@@ -265,9 +265,9 @@ def test_violations_with_parsed_witness(dash):
     status, body = dash.get("/api/runs/r-mid/violations")
     assert status == 200 and body["last_id"] == 3 and body["more"] is False
     assert body["violations"] == [
-        {"id": 1, "property": "p1", "time": 3, "wall": 2003, "witness": WITNESS},
-        {"id": 2, "property": "p2", "time": 5, "wall": 2005, "witness": HEX_WITNESS},
-        {"id": 3, "property": "p2", "time": 9, "wall": 2009, "witness": "not json ["},  # kept, as text
+        {"id": 1, "property": "p1", "time": 3, "wall": 2003, "witness": WITNESS, "explanation": None},
+        {"id": 2, "property": "p2", "time": 5, "wall": 2005, "witness": HEX_WITNESS, "explanation": None},
+        {"id": 3, "property": "p2", "time": 9, "wall": 2009, "witness": "not json [", "explanation": None},  # as text
     ]
     status, body = dash.get("/api/runs/r-mid/violations?after=1&property=p2&limit=1")
     assert [v["id"] for v in body["violations"]] == [2] and body["more"] is True
@@ -364,7 +364,8 @@ def test_events_deliver_rows_inserted_after_connecting(dash, db):
         got[e[0]] = e
     # (ev.next's timeout bounds the wait: rows arrive live, not at the end of a long poll)
     assert got["verdict"][1] == [{"id": vid, "property": "p9", "time": 4.5, "value": False, "wall": 3010}]
-    assert got["violation"][1] == [{"id": kid, "property": "p9", "time": 4.5, "wall": 3010, "witness": WITNESS}]
+    assert got["violation"][1] == [{"id": kid, "property": "p9", "time": 4.5, "wall": 3010, "witness": WITNESS,
+                                    "explanation": None}]
     assert [(c["id"], c["counters"]) for c in got["counters"][1]] == [(cid, {"input": "a", "received": 500})]
     assert got["counters"][1][0]["rates"] == {"seconds": 4, "received_per_s": 50, "checked_per_s": None}
     assert got["counters"][2] == f"{vid},{kid},{cid}"  # the cursor, for a reconnecting EventSource
@@ -473,6 +474,27 @@ def test_database_written_by_rvc_check(tmp_path):
         detail = d.get(f"/api/runs/{run}")[1]
         assert detail["properties"] == [{"name": "p1", "spec": "{speed < 40}", "value": False, "since": 3,
                                          "changes": 4, "violations": 2}]
+    finally:
+        assert d.stop() == 0
+
+
+def test_explanations_kept_and_an_older_database_gains_their_column(tmp_path):
+    """A database made before explanations were stored (violations without the column) is
+    migrated by the next run, which keeps --explain's sentences; the API returns them."""
+    db = tmp_path / "old.db"
+    with sqlite3.connect(db) as c:
+        for sql in SCHEMA:
+            c.execute(sql.replace(", explanation TEXT)", ")"))
+    trace = tmp_path / "t.jsonl"
+    trace.write_text("".join(json.dumps({"speed": s}) + "\n" for s in [10, 50]))
+    r = subprocess.run([rvc_binary(), "check", "--explain", "-s", "{speed < 40}", "--output", f"sqlite:{db}",
+                        str(trace)], capture_output=True, text=True, timeout=30)
+    assert r.returncode == 1, r.stderr
+    d = Dashboard(f"sqlite:{db}")
+    try:
+        run = d.get("/api/runs")[1]["runs"][0]["run"]
+        violations = d.get(f"/api/runs/{run}/violations")[1]["violations"]
+        assert [v["explanation"] for v in violations] == [["{speed < 40} is false at step 1"]]
     finally:
         assert d.stop() == 0
 

@@ -120,7 +120,7 @@ def test_a_rows_of_one_run(rvc_pg, pg, tmp_path):
     trace = tmp_path / "a.jsonl"
     trace.write_text("".join(l + "\n" for l in TRACE_A))
     props = props_file(tmp_path)
-    r = subprocess.run([rvc_pg, "check", "-p", props, str(trace), "--output", pg.uri, "--witness", "3"],
+    r = subprocess.run([rvc_pg, "check", "-p", props, str(trace), "--output", pg.uri, "--witness", "3", "--explain"],
                        capture_output=True, text=True, timeout=30)
     assert r.returncode == 1, r.stderr  # violated
 
@@ -142,15 +142,20 @@ def test_a_rows_of_one_run(rvc_pg, pg, tmp_path):
     # lines up to the violating one, oldest first (seq: the line number).
     w = lambda *lines: [{"input": str(trace), "seq": n, "payload": TRACE_A[n - 1]} for n in lines]
     assert violations == [("now", 2, w(1, 2, 3)), ("always", 2, w(1, 2, 3)), ("now", 5, w(4, 5, 6))]
+    # --explain: each violation keeps why, as the verdict line says it.
+    explained = [json.loads(r["explanation"]) for r in pg.sql("SELECT explanation FROM violations ORDER BY id")]
+    assert explained[0] == ["{a} is false at step 2"]
+    assert explained[1] == ["(historically {a}) is false: {a} failed at least once at steps 0..2", "{a} is false at step 2"]
     walls = pg.sql("SELECT wall FROM verdicts ORDER BY id")
     assert all(run["started_at"] <= v["wall"] <= run["ended_at"] for v in walls)
 
     # The same run into SQLite stores the same rows.
     db = tmp_path / "a.db"
-    r = subprocess.run([rvc_pg, "check", "-p", props, str(trace), "--output", f"sqlite:{db}", "--witness", "3"],
-                       capture_output=True, text=True, timeout=30)
+    r = subprocess.run([rvc_pg, "check", "-p", props, str(trace), "--output", f"sqlite:{db}", "--witness", "3",
+                        "--explain"], capture_output=True, text=True, timeout=30)
     assert r.returncode == 1, r.stderr
     with sqlite3.connect(db) as con:
+        assert [json.loads(e) for (e,) in con.execute("SELECT explanation FROM violations ORDER BY id")] == explained
         assert [tuple(r) for r in con.execute("SELECT property, time, value FROM verdicts ORDER BY id")] == verdicts
         assert [(p, t, json.loads(w)) for p, t, w in
                 con.execute("SELECT property, time, witness FROM violations ORDER BY id")] == violations
