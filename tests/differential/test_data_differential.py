@@ -26,7 +26,7 @@ import pytest
 
 reelay = pytest.importorskip("reelay")
 
-from randspec import operator
+from randspec import operator, trace
 from test_reelay_differential import condense, describe, run_rvc, with_heartbeats
 
 CASES = int(os.environ.get("RVC_DIFF_CASES", "60"))
@@ -84,22 +84,13 @@ def for_reelay(f):
 
 
 def data_trace(rng, length, dense=False):
-    events = []
-    t = rng.choice([0, 0, 0.5, 1, 3])
-    for _ in range(length):
-        e = {}
-        if dense:
-            e["time"] = t
-            t += rng.choice([0.25, 0.5, 0.5, 1, 1, 1.5, 2, 3])
+    """randspec's trace (p, q, r, x, and times in dense time) with two string fields to bind,
+    missing now and then like the others."""
+    events = trace(rng, length, dense)
+    for e in events:
         for key in ("id", "o"):
             if rng.random() < 0.8:
                 e[key] = rng.choice(IDS)
-        for key in ("p", "q"):
-            if rng.random() < 0.85:
-                e[key] = rng.random() < 0.5
-        if rng.random() < 0.8:
-            e["x"] = rng.randint(0, 4)
-        events.append(e)
     return events
 
 

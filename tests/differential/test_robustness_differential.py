@@ -49,12 +49,20 @@ def value(v):
     return float(v)
 
 
-def run_rvc(rvc, tmp_path, formulas, events):
+def add_real_field(rng, events):
+    """A real-valued y in most messages, so margins are not all 0, 1 and infinities."""
+    for e in events:
+        if rng.random() < 0.8:
+            e["y"] = rng.choice([-2.5, -1.25, -0.5, 0, 0.25, 0.5, 1.75, 3])
+
+
+def run_rvc(rvc, tmp_path, formulas, events, dense=False):
     props = tmp_path / "props.json"
     props.write_text(json.dumps({"properties": [{"name": f"f{i}", "spec": f} for i, f in enumerate(formulas)]}))
     tr = tmp_path / "trace.jsonl"
     write_jsonl(tr, events)
-    proc = subprocess.run([rvc, "check", "--robustness", "--all", "--properties", str(props), str(tr)],
+    proc = subprocess.run([rvc, "check", "--robustness", "--dense" if dense else "--all", "--properties", str(props),
+                           str(tr)],
                           capture_output=True, text=True)
     assert proc.returncode in (0, 1), f"rvc failed ({proc.returncode}): {proc.stderr}"
     out = {f"f{i}": [] for i in range(len(formulas))}
@@ -69,9 +77,7 @@ def test_discrete_robustness_matches_reelay(rvc, tmp_path, seed):
     rng = random.Random(7000 + seed)
     formulas = [robust_formula(rng, rng.randint(1, 4)) for _ in range(FORMULAS_PER_CASE)]
     events = trace(rng, rng.randint(20, 60), dense=False)
-    for e in events:
-        if rng.random() < 0.8:
-            e["y"] = rng.choice([-2.5, -1.25, -0.5, 0, 0.25, 0.5, 1.75, 3])
+    add_real_field(rng, events)
     ours = run_rvc(rvc, tmp_path, formulas, events)
     for i, f in enumerate(formulas):
         m = reelay.discrete_timed_monitor(pattern=f, semantics="robustness", condense=False)
@@ -131,20 +137,8 @@ def test_dense_robustness_matches_reelay(rvc, tmp_path, seed):
     rng = random.Random(8000 + seed)
     formulas = [dense_robust_formula(rng, rng.randint(1, 4)) for _ in range(FORMULAS_PER_CASE)]
     events = trace(rng, rng.randint(10, 40), dense=True)
-    for e in events:
-        if rng.random() < 0.8:
-            e["y"] = rng.choice([-2.5, -1.25, -0.5, 0, 0.25, 0.5, 1.75, 3])
-    props = tmp_path / "props.json"
-    props.write_text(json.dumps({"properties": [{"name": f"f{i}", "spec": f} for i, f in enumerate(formulas)]}))
-    tr = tmp_path / "trace.jsonl"
-    write_jsonl(tr, events)
-    proc = subprocess.run([rvc, "check", "--dense", "--robustness", "--properties", str(props), str(tr)],
-                          capture_output=True, text=True)
-    assert proc.returncode in (0, 1), f"rvc failed ({proc.returncode}): {proc.stderr}"
-    ours = {f"f{i}": [] for i in range(len(formulas))}
-    for line in proc.stdout.splitlines():
-        v = json.loads(line)
-        ours[v["property"]].append((v["time"], value(v["value"])))
+    add_real_field(rng, events)
+    ours = run_rvc(rvc, tmp_path, formulas, events, dense=True)
     probed = with_heartbeats(events)
     for i, f in enumerate(formulas):
         m = reelay.dense_timed_monitor(pattern=f, semantics="robustness")

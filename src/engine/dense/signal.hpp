@@ -1,7 +1,9 @@
-// A Boolean signal restricted to the current segment [begin, end): the list of
+// A signal restricted to the current segment [begin, end): the list of
 // (time, value) pieces, each holding until the next piece or `end`. The first
 // piece starts at `begin`; consecutive pieces differ in value (normalized).
-// Each node of a dense monitor owns one and reuses its capacity every event.
+// Boolean signals carry verdicts; real-valued ones (robust/dense_monitor)
+// carry robustness. Each node of a dense monitor owns one and reuses its
+// capacity every event.
 #pragma once
 
 #include <cstddef>
@@ -9,19 +11,21 @@
 
 namespace rvc::engine::dense {
 
-struct Piece {
+template <class V>
+struct BasicPiece {
   double t;
-  bool v;
+  V v;
 };
 
-struct Signal {
-  std::vector<Piece> pieces;
+template <class V>
+struct BasicSignal {
+  std::vector<BasicPiece<V>> pieces;
 
   void clear() { pieces.clear(); }
   // Appends a change at t (t >= last piece's time), keeping the list normalized.
-  void set(double t, bool v) {
+  void set(double t, V v) {
     if (!pieces.empty()) {
-      Piece& last = pieces.back();
+      BasicPiece<V>& last = pieces.back();
       if (last.v == v) return;
       if (last.t == t) {  // replaces a piece of zero length
         pieces.pop_back();
@@ -30,34 +34,28 @@ struct Signal {
     }
     pieces.push_back({t, v});
   }
-  void constant(double begin, bool v) {
+  void constant(double begin, V v) {
     pieces.clear();
     pieces.push_back({begin, v});
   }
 };
 
+using Piece = BasicPiece<bool>;
+using Signal = BasicSignal<bool>;
+
 // Walks the pieces of two signals over the same segment in time order, calling
 // f(t, left_value, right_value) at each point where either changes.
-template <class F>
-void zip(const Signal& a, const Signal& b, F&& f) {
-  std::size_t i = 0, j = 0;
-  bool va = a.pieces[0].v, vb = b.pieces[0].v;
-  double t = a.pieces[0].t;
-  i = j = 1;
-  f(t, va, vb);
+template <class V, class F>
+void zip(const BasicSignal<V>& a, const BasicSignal<V>& b, F&& f) {
+  std::size_t i = 1, j = 1;
+  V va = a.pieces[0].v, vb = b.pieces[0].v;
+  f(a.pieces[0].t, va, vb);
   while (i < a.pieces.size() || j < b.pieces.size()) {
-    double ta = i < a.pieces.size() ? a.pieces[i].t : 0, tb = j < b.pieces.size() ? b.pieces[j].t : 0;
-    if (j >= b.pieces.size() || (i < a.pieces.size() && ta < tb)) {
-      va = a.pieces[i++].v;
-      t = ta;
-    } else if (i >= a.pieces.size() || tb < ta) {
-      vb = b.pieces[j++].v;
-      t = tb;
-    } else {
-      va = a.pieces[i++].v;
-      vb = b.pieces[j++].v;
-      t = ta;
-    }
+    const bool take_a = j >= b.pieces.size() || (i < a.pieces.size() && a.pieces[i].t <= b.pieces[j].t);
+    const bool take_b = i >= a.pieces.size() || (j < b.pieces.size() && b.pieces[j].t <= a.pieces[i].t);
+    const double t = take_a ? a.pieces[i].t : b.pieces[j].t;
+    if (take_a) va = a.pieces[i++].v;
+    if (take_b) vb = b.pieces[j++].v;
     f(t, va, vb);
   }
 }
