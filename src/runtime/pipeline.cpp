@@ -116,6 +116,18 @@ io::ReadResult Pipeline::on_object(const io::Position& where, simdjson::ondemand
   return io::ReadResult::Pending;
 }
 
+// A data reference past --max-data-values stops the run: the error names
+// the message that brought the value too many.
+template <class F>
+void Pipeline::step_checker(F&& step) {
+  try {
+    step();
+  } catch (const engine::data::DataLimitError& e) {
+    throw engine::data::DataLimitError(options_.position_name + " " + std::to_string(pending_where_->number()) + ": " +
+                                       e.what());
+  }
+}
+
 void Pipeline::commit() {
   if (!pending_) return;
   pending_ = false;
@@ -146,7 +158,7 @@ void Pipeline::commit() {
     checker_.step_robust(decoder_.margins());
   } else if (checker_.model() == engine::TimeModel::Discrete) {
     commit_values();
-    checker_.step(values(), bound());
+    step_checker([&] { checker_.step(values(), bound()); });
   } else {
     // Dense: this message closes [previous time, its time) with the previous values.
     double t = message_time();
@@ -159,7 +171,7 @@ void Pipeline::commit() {
       return;
     }
     if (checker_.robustness()) checker_.step_robust(begin, t, decoder_.margins());
-    else checker_.step(begin, t, values(), bound());
+    else step_checker([&] { checker_.step(begin, t, values(), bound()); });
     commit_values();
     has_time_ = true;
     last_time_ = t;

@@ -182,7 +182,7 @@ def test_data_references_values_limits_and_refusals(rvc, tmp_path):
     r = subprocess.run([rvc, "check", "--max-data-values", "1", "--spec", "exists[x]. {id: *x}", str(trace)],
                        capture_output=True, text=True)
     assert r.returncode == 5 and r.stdout.count("\n") == 1, r.stderr  # held at step 0, stopped at the 2nd value
-    assert "property 'p1': variable 'x' would take more than 1 distinct values (--max-data-values)" in r.stderr
+    assert "line 2: property 'p1': variable 'x' would take more than 1 distinct values (--max-data-values)" in r.stderr
     r = subprocess.run([rvc, "check", "--spec", "exists[x]. {id: *y}", str(trace)], capture_output=True, text=True)
     assert r.returncode == 2 and "column 13" in r.stderr and "variable 'y' is not bound" in r.stderr, r.stderr
     r = subprocess.run([rvc, "check", "--robustness", "--spec", spec, str(trace)], capture_output=True, text=True)
