@@ -1,6 +1,7 @@
 #include "io/cdr_decoder.hpp"
 
 #include <algorithm>
+#include <limits>
 
 #include "io/cdr_cursor.hpp"
 
@@ -59,6 +60,10 @@ bool number(CdrCursor& in, double& d) {
 CdrDecoder::CdrDecoder(const engine::AtomTable& atoms, const MessageType& type, const DecoderOptions& options)
     : atoms_(atoms), options_(options), current_(atoms.size(), 0), next_(atoms.size(), 0) {
   root_ = std::move(*plan_of(type));
+  if (options_.robustness) {  // only then: the typed Boolean path does no margin work
+    margin_.assign(atoms.size(), -std::numeric_limits<double>::infinity());
+    next_margin_ = margin_;
+  }
   const auto& tests = atoms_.tests();
   for (size_t id = 0; id < tests.size(); ++id) {
     // The dense time field itself may be tested, but is not a field when it
@@ -168,6 +173,10 @@ bool CdrDecoder::decode(std::string_view sample, std::string& error, std::vector
   // Fields are always there, array elements not ({pts[3]: *}): presence is
   // false until the decoder passes the value.
   for (int id : presence_tests_) next_[id] = 0;
+  if (options_.robustness) {
+    std::copy(margin_.begin(), margin_.end(), next_margin_.begin());
+    for (int id : presence_tests_) next_margin_[id] = -std::numeric_limits<double>::infinity();
+  }
   malformed_ = false;
   refused_ = false;
   error_ = &error;
@@ -204,7 +213,10 @@ bool CdrDecoder::planned_value(CdrCursor& in, const FieldPlan& f) {
     if (!(f.below ? message(in, *f.below) : indexed_array(in, f))) return false;
     // A message or array with tested parts inside answers only presence (as in JSON).
     for (int id : f.tests)
-      if (atoms_.tests()[id].op == FOp::Present) next_[id] = 1;
+      if (atoms_.tests()[id].op == FOp::Present) {
+        next_[id] = 1;
+        if (options_.robustness) next_margin_[id] = std::numeric_limits<double>::infinity();
+      }
     return true;
   }
   if (!f.tests.empty() || f.time != TimeRole::None) return tested_field(in, f);
@@ -277,6 +289,7 @@ bool CdrDecoder::apply(const FieldPlan& f, const FieldValue& v) {
     const int result = evaluate_test(t, v);
     if (result >= 0) {
       next_[id] = static_cast<uint8_t>(result);
+      if (options_.robustness) next_margin_[id] = test_margin(t, v);
       if (t.op == FOp::Bind) next_bound_[id] = bound_ids_.id(v);
       continue;
     }

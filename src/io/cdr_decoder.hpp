@@ -48,9 +48,13 @@ class CdrDecoder {
   void commit() {
     current_.swap(next_);
     bound_.swap(next_bound_);
+    if (options_.robustness) margin_.swap(next_margin_);
   }
 
   const uint8_t* values() const { return current_.data(); }
+  // With DecoderOptions::robustness: each test's robustness (io::test_margin,
+  // as JsonDecoder::margins); -inf before the first sample.
+  const double* margins() const { return margin_.data(); }
   // Data references: per atom, the id of the value bound last (as JsonDecoder::bound).
   const uint32_t* bound() const { return bound_.empty() ? nullptr : bound_.data(); }
   double time() const { return time_; }
@@ -94,6 +98,7 @@ class CdrDecoder {
   std::vector<int> presence_tests_;
   std::vector<uint8_t> current_, next_;
   std::vector<uint32_t> bound_, next_bound_;  // sized only when some test binds
+  std::vector<double> margin_, next_margin_;  // sized only with DecoderOptions::robustness
   BoundValues bound_ids_;
   double time_ = 0, next_time_ = 0;
   double sec_ = 0, nanosec_ = 0;

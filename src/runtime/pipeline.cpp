@@ -15,11 +15,7 @@ namespace {
 engine::Checker build(const std::vector<engine::PropertySpec>& properties, const PipelineOptions& options,
                       engine::VerdictCallback on_verdict) {
   engine::Checker checker(options.model, options.emit_all, std::move(on_verdict));
-  if (options.robustness) {
-    if (options.type)
-      throw std::invalid_argument("--robustness reads JSON messages for now (not --type samples)");
-    checker.enable_robustness();
-  }
+  if (options.robustness) checker.enable_robustness();
   if (options.explain) checker.enable_explain();
   checker.set_max_data_values(options.max_data_values);
   for (const auto& p : properties) {
@@ -65,7 +61,8 @@ Pipeline::Pipeline(const std::vector<engine::PropertySpec>& properties, const Pi
 void Pipeline::make_typed_decoder() {
   if (!options_.type) return;
   typed_.emplace(atoms_, *options_.type,
-                 io::DecoderOptions{options_.model == engine::TimeModel::Dense, options_.time_field, options_.strict});
+                 io::DecoderOptions{options_.model == engine::TimeModel::Dense, options_.time_field, options_.strict,
+                                    options_.robustness});
 }
 
 Pipeline::Pipeline(const engine::AtomTable& atoms, const PipelineOptions& options, MessageHook hook)
@@ -155,7 +152,7 @@ void Pipeline::commit() {
     commit_values();
   } else if (checker_.robustness() && checker_.model() == engine::TimeModel::Discrete) {
     commit_values();
-    checker_.step_robust(decoder_.margins());
+    checker_.step_robust(margins());
   } else if (checker_.model() == engine::TimeModel::Discrete) {
     commit_values();
     step_checker([&] { checker_.step(values(), bound()); });
@@ -170,7 +167,7 @@ void Pipeline::commit() {
       on_error(io::LineError{pending_where_->number(), 0, why});
       return;
     }
-    if (checker_.robustness()) checker_.step_robust(begin, t, decoder_.margins());
+    if (checker_.robustness()) checker_.step_robust(begin, t, margins());
     else step_checker([&] { checker_.step(begin, t, values(), bound()); });
     commit_values();
     has_time_ = true;

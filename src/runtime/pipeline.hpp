@@ -30,7 +30,7 @@ struct PipelineOptions {
   std::string position_name = "line";  // how errors name a message: "line 12", "seq 12"
   size_t max_reported = 100;           // errors and warnings printed before going quiet
   bool parse_only = false;             // decode every message but run no monitor (benchmark floor)
-  bool robustness = false;             // robustness values instead of Booleans (discrete, JSON)
+  bool robustness = false;             // robustness values instead of Booleans
   bool explain = false;                // a violation's verdict says why (discrete)
   uint32_t max_data_values = 100000;   // data references: distinct values per variable
   size_t max_message_size = 1 << 20;   // longest message: a line, a payload, a line inside a batched payload
@@ -98,6 +98,7 @@ class Pipeline final : public io::JsonlHandler, public Feed {
   void commit_values() { typed_ ? typed_->commit() : decoder_.commit(); }
   const uint8_t* values() const { return typed_ ? typed_->values() : decoder_.values(); }
   const uint32_t* bound() const { return typed_ ? typed_->bound() : decoder_.bound(); }
+  const double* margins() const { return typed_ ? typed_->margins() : decoder_.margins(); }
   double message_time() const { return typed_ ? typed_->time() : decoder_.time(); }
   engine::Checker checker_;
   PipelineOptions options_;

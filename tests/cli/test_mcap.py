@@ -101,6 +101,42 @@ def test_rosbag2_bag_checks_like_its_json(rvc, tmp_path, typestore):
     assert dense.stdout == want.stdout and '"value":false' in want.stdout, dense.stderr
 
 
+def test_rosbag2_robustness_like_its_json(rvc, tmp_path, typestore):
+    """--robustness on a bag: each test's margin comes from the CDR sample as from the JSON value
+    (io::test_margin on both paths), so every value equals the JSON trace's, discrete and dense,
+    bounded since included."""
+    gears = gear_values(60, 3)
+    steers = [(t + 7, random.Random(t).uniform(-0.6, 0.6)) for t, _ in gear_values(80, 4)]
+    bag = write_rosbag2(tmp_path, typestore, gears, steers)
+    f32 = lambda a: struct.unpack("<f", struct.pack("<f", a))[0]  # the wire type is float32
+    steer_rows = [{"t": t / 1e9, "steering_tire_angle": f32(a)} for t, a in steers]
+    steer_json = json_trace(tmp_path, "steer.jsonl", steer_rows)
+
+    def values(out):
+        return [json.loads(l)["value"] for l in out.splitlines()]
+
+    cases = [  # (typed args, JSON args)
+        (["--all", "--spec", "{report == REVERSE} since[0:2] {report != PARK}", bag, "--topic", GEAR_TOPIC],
+         ["--all", "--spec", "{report == 20} since[0:2] {report != 22}",
+          json_trace(tmp_path, "gear.jsonl", [{"report": r} for _, r in gears])]),
+        (["--all", "--spec", "({steering_tire_angle < 0.5} since[1:3] {steering_tire_angle > -0.2}) or "
+          "historically[0:2]{steering_tire_angle > -0.55}", bag, "--topic", STEER_TOPIC],
+         ["--all", "--spec", "({steering_tire_angle < 0.5} since[1:3] {steering_tire_angle > -0.2}) or "
+          "historically[0:2]{steering_tire_angle > -0.55}", steer_json]),
+        (["--dense", "--spec", "{steering_tire_angle < 0.5} since[0.1:0.4] {steering_tire_angle > -0.2}", bag,
+          "--topic", STEER_TOPIC],
+         ["--dense", "--time-field", "t", "--spec",
+          "{steering_tire_angle < 0.5} since[0.1:0.4] {steering_tire_angle > -0.2}", steer_json]),
+    ]
+    for typed_args, json_args in cases:
+        got = run([rvc, "check", "--robustness", *typed_args])
+        want = run([rvc, "check", "--robustness", *json_args])
+        assert got.returncode == want.returncode and got.returncode in (0, 1), (got.stderr, want.stderr)
+        assert got.stdout == want.stdout, got.stderr
+        # margins, not only infinities
+        assert any(isinstance(v, (int, float)) and v != 0 for v in values(want.stdout)), want.stdout
+
+
 def test_choosing_the_topic(rvc, tmp_path, typestore):
     bag = write_rosbag2(tmp_path, typestore, gear_values(5, 3), [(10**9 * i, 0.1) for i in range(1, 4)])
     r = run([rvc, "check", "--spec", "{report == 2}", bag])

@@ -4,7 +4,9 @@
 // with the same words) and hand-computed dense times.
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <random>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -127,6 +129,58 @@ TEST(CdrDecoder, VerdictsAndWarningsEqualTheJsonPath) {
       EXPECT_EQ(typed.stats.warnings, from_json.stats.warnings);
       EXPECT_EQ(typed.verdicts, from_json.verdicts) << (big ? "big" : "little") << " endian";
     }
+  }
+}
+
+// --robustness on typed samples: each test's margin as on the same message
+// as JSON (io::test_margin on both paths), so every robustness value equals
+// the JSON path's, discrete and dense, in both endiannesses. The properties
+// read every kind of field (integers of each width, floats, strings,
+// Booleans, nested and indexed fields, presence, wrong types) under every
+// operator, since with and without bounds included.
+TEST(CdrDecoder, RobustnessEqualsTheJsonPath) {
+  Types types;
+  const std::vector<engine::PropertySpec> props = {
+      {"numbers", "({i8 < 0} && {u16 <= 30000}) || {i32 > 0} && not {u64 > 1000000} || {f32 >= 0.25}"},
+      {"since", "({f64 > 500} since[1:3] {inner.x > 0}) || ({i16 > 0} since {b < 100})"},
+      {"half", "historically[0:2]({u8 >= 128} since[1:] {inners[0].x < 1}) || once[1:2]{fixed[1] != 4}"},
+      {"kinds", "({flag} && {name == \"ab\"}) || {inner.on} && {short_name: *} || {bounded[1]} -> {i64 < 0}"},
+      {"wrong", "{name > 3} || {inner.on == 1} || {u8 == \"a\"}"},
+  };
+  const auto run_robust = [&](const std::vector<std::string>& jsons, const msg::MessageType* typed,
+                              engine::TimeModel model, bool big_endian) {
+    runtime::PipelineOptions o;
+    o.emit_all = true;
+    o.model = model;
+    o.time_field = "t";
+    o.type = typed;
+    o.robustness = true;
+    o.max_reported = 0;
+    std::vector<std::string> out;
+    runtime::Pipeline p(props, o, [&](const engine::Verdict& v) {
+      EXPECT_TRUE(v.robust);
+      char value[64];
+      std::snprintf(value, sizeof value, "@%.17g=%.17g", v.time, v.robustness);
+      out.push_back(v.property + value);
+    });
+    uint64_t seq = 0;
+    for (const auto& j : jsons) p.feed(typed ? encode(*typed, j, big_endian) : j, ++seq);
+    EXPECT_EQ(p.stats().rejected, 0u);
+    EXPECT_EQ(p.stats().accepted, jsons.size());
+    return out;
+  };
+  std::mt19937 rng(515);
+  std::vector<std::string> jsons;
+  for (int i = 0; i < 300; ++i) jsons.push_back(random_all(rng, 0.5 * (i + 1)));
+  for (auto model : {engine::TimeModel::Discrete, engine::TimeModel::Dense}) {
+    const std::vector<std::string> from_json = run_robust(jsons, nullptr, model, false);
+    ASSERT_GT(from_json.size(), 100u);
+    // Margins, not only infinities and 0/1: many different values.
+    std::set<std::string> values;
+    for (const std::string& v : from_json) values.insert(v.substr(v.find('=')));
+    EXPECT_GT(values.size(), 20u);
+    for (bool big : {false, true})
+      EXPECT_EQ(run_robust(jsons, types.all, model, big), from_json) << (big ? "big" : "little") << " endian";
   }
 }
 

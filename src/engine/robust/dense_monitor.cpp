@@ -2,26 +2,43 @@
 
 #include <algorithm>
 #include <limits>
-#include <stdexcept>
 
 namespace rvc::engine::robust {
 
-std::string DenseMonitor::unsupported(const Program& program) {
-  for (const Instr& in : program.code)
-    if (in.code == Code::Since)
-      return "since has no dense-time robustness in rvc yet (once, historically, with or without bounds, do)";
-  return "";
-}
-
 DenseMonitor::DenseMonitor(const Program& program)
     : code_(program.code), signal_(program.code.size()), state_(program.code.size(), -1) {
-  if (std::string why = unsupported(program); !why.empty()) throw std::invalid_argument(why);
   for (size_t i = 0; i < code_.size(); ++i) {
     const Instr& in = code_[i];
+    if (in.code == Code::Since) {
+      state_[i] = static_cast<int32_t>(since_.size());
+      since_.push_back({-std::numeric_limits<double>::infinity()});
+      if (in.bounds.explicit_bounds) {
+        since_.back().bounded = static_cast<int32_t>(bounded_.size());
+        bounded_.emplace_back(in.bounds.lo, in.bounds.hi);
+      }
+      continue;
+    }
     if (in.code != Code::Once && in.code != Code::Historically) continue;
     state_[i] = static_cast<int32_t>(window_.size());
     window_.emplace_back(in.bounds.lo, in.bounds.hi, in.code == Code::Once ? 1.0 : -1.0);
   }
+}
+
+void DenseMonitor::since(const Instr& in, Since& s, double end, RealSignal& out) {
+  const RealSignal& phi = signal_[static_cast<size_t>(in.a)];
+  const RealSignal& psi = signal_[static_cast<size_t>(in.b)];
+  RealSignal& unbounded = s.bounded < 0 ? out : bounded_[static_cast<size_t>(s.bounded)].unbounded;
+  unbounded.clear();
+  zip(phi, psi, [&](double t, double l, double r) {
+    s.held = std::max(r, std::min(l, s.held));
+    unbounded.set(t, s.held);
+  });
+  if (s.bounded < 0) return;
+  BoundedSince& b = bounded_[static_cast<size_t>(s.bounded)];
+  b.hold.update(b.unbounded, end, b.held);
+  b.window.update(psi, end, b.windowed);
+  out.clear();
+  zip(b.held, b.windowed, [&](double t, double l, double r) { out.set(t, std::min(l, r)); });
 }
 
 const RealSignal& DenseMonitor::step(double begin, double end, const double* margins) {
@@ -49,8 +66,8 @@ const RealSignal& DenseMonitor::step(double begin, double end, const double* mar
       case Code::Historically:
         window_[static_cast<size_t>(state_[i])].update(signal_[static_cast<size_t>(in.a)], end, out);
         break;
+      case Code::Since: since(in, since_[static_cast<size_t>(state_[i])], end, out); break;
       case Code::Pre:  // refused by the compiler in dense time
-      case Code::Since:  // refused (unsupported)
       case Code::Bind:   // refused by the Checker
       case Code::Exists:
       case Code::Forall: out.constant(begin, -kInf); break;

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <limits>
-#include <stdexcept>
 
 namespace rvc::engine::robust {
 namespace {
@@ -13,16 +12,7 @@ Step to_step(double v) { return v >= static_cast<double>(kForever) ? kForever : 
 
 }  // namespace
 
-std::string Monitor::unsupported(const Program& program) {
-  for (const Instr& in : program.code)
-    if (in.code == Code::Since && in.bounds.explicit_bounds)
-      return "since with time bounds has no robustness semantics in rvc yet (unbounded since, once and historically "
-             "with bounds do)";
-  return "";
-}
-
 Monitor::Monitor(const Program& program) : program_(program) {
-  if (std::string why = unsupported(program); !why.empty()) throw std::invalid_argument(why);
   const size_t n = program_.code.size();
   value_.assign(n, 0);
   previous_.assign(n, -std::numeric_limits<double>::max());  // Reelay's pre before the first step
@@ -39,6 +29,10 @@ Monitor::Monitor(const Program& program) : program_(program) {
       case Code::Since:  // no candidate yet: -inf (Reelay's since, unlike its once, starts there)
         state_[i] = static_cast<int32_t>(since_.size());
         since_.push_back(-kInf);
+        // Written bounds [lo:hi]: also the minimum of that value over the
+        // steps 0..lo back and the maximum of ψ over the steps lo..hi back.
+        bounded_of_.push_back(in.bounds.explicit_bounds ? static_cast<int32_t>(bounded_since_.size()) : -1);
+        if (in.bounds.explicit_bounds) bounded_since_.emplace_back(lo, hi);
         break;
       default: break;
     }
@@ -69,6 +63,10 @@ double Monitor::step(const double* margins) {
         double& held = since_[state_[i]];
         held = std::max(b, std::min(a, held));
         r = held;
+        if (const int32_t k = bounded_of_[state_[i]]; k >= 0) {
+          BoundedSince& bounded = bounded_since_[k];
+          r = std::min(bounded.hold.update(now_, held), bounded.window.update(now_, b));
+        }
         break;
       }
       case Code::Bind:  // refused by the Checker: no robustness for data references
