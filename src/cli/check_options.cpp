@@ -13,7 +13,8 @@ void CheckOptions::add_to(CLI::App& app) {
                "Report robustness values (Reelay's quantitative semantics: how far from changing the verdict; "
                "positive holds) instead of true/false; JSON input (docs/semantics.md)");
   app.add_flag("--explain", explain,
-               "With each violation, say why: the sub-formulas and steps that made the verdict false (discrete time)");
+               "With each violation, say why: the sub-formulas and steps (dense: intervals) that made the verdict "
+               "false, and for data references the value that decided");
   app.add_option("--max-data-values", max_data_values,
                  "Data references (exists[x]. {id: *x}): the most distinct values one variable may take; more stops "
                  "the run with an error (memory and time per message grow with them)")

@@ -17,8 +17,13 @@ void Checker::enable_robustness() {
 }
 
 void Checker::enable_explain() {
-  if (model_ != TimeModel::Discrete) throw std::invalid_argument("--explain works in discrete time for now (not with --dense)");
+  // A robustness value is decided by one sub-formula's value at one step, not
+  // by the Boolean reasons the sentences give: refused rather than half-said.
+  if (robustness_)
+    throw std::invalid_argument("--explain explains true/false verdicts for now (not --robustness values)");
   explain_ = true;
+  for (auto& m : data_) m.enable_explain();  // properties added before: name the values they meet
+  for (auto& m : dense_data_) m.enable_explain();
 }
 
 void Checker::add_property(const PropertySpec& property) {
@@ -32,9 +37,11 @@ void Checker::add_property(const PropertySpec& property) {
                             property.spec, 1);
     if (model_ == TimeModel::Dense) {
       dense_data_.emplace_back(program, property.name, max_data_values_);
+      if (explain_) dense_data_.back().enable_explain();
       where_.emplace_back(kData, static_cast<uint32_t>(dense_data_.size() - 1));
     } else {
       data_.emplace_back(program, property.name, max_data_values_);
+      if (explain_) data_.back().enable_explain();
       where_.emplace_back(kData, static_cast<uint32_t>(data_.size() - 1));
     }
     names_.push_back(property.name);
@@ -42,8 +49,6 @@ void Checker::add_property(const PropertySpec& property) {
     return;
   }
   if (robustness_ && model_ == TimeModel::Dense) {
-    if (std::string why = robust::DenseMonitor::unsupported(program); !why.empty())
-      throw spec::SpecError(why, property.spec, 1);
     robust_dense_.emplace_back(program);
     last_robustness_.push_back(std::numeric_limits<double>::quiet_NaN());
     names_.push_back(property.name);
@@ -51,8 +56,6 @@ void Checker::add_property(const PropertySpec& property) {
     return;
   }
   if (robustness_) {
-    if (std::string why = robust::Monitor::unsupported(program); !why.empty())
-      throw spec::SpecError(why, property.spec, 1);
     robust_.emplace_back(program);
     last_robustness_.push_back(std::numeric_limits<double>::quiet_NaN());
   }
@@ -88,7 +91,14 @@ void Checker::step(const uint8_t* atoms, const uint32_t* bound) {
   for (auto& m : discrete_) m.step(atoms);
   for (size_t i = 0; i < where_.size(); ++i) {
     if (where_[i].first == kData) {
-      report(i, now, data_[where_[i].second].step(atoms, bound));
+      data::DiscreteMonitor& d = data_[where_[i].second];
+      const bool value = d.step(atoms, bound);
+      if (explain_ && !value && last_[i] != 0) {  // a violation starts: say why
+        const std::vector<std::string> why = d.explain(&value_names_);
+        report(i, now, value, &why);
+      } else {
+        report(i, now, value);
+      }
       continue;
     }
     const discrete::Monitor& m = discrete_[where_[i].first];
@@ -134,7 +144,15 @@ void Checker::step(double begin, double end, const uint8_t* atoms, const uint32_
     const auto [kind, k] = where_[i];
     const dense::Signal& s =
         kind == kData ? dense_data_[k].step(begin, end, atoms, bound) : dense_[k].step(begin, end, atoms);
-    for (const dense::Piece& p : s.pieces) report(i, p.t, p.v);
+    for (const dense::Piece& p : s.pieces) {
+      if (explain_ && !p.v && last_[i] != 0) {  // a violation starts at p.t: say why, from this segment's signals
+        const std::vector<std::string> why =
+            kind == kData ? dense_data_[k].explain(p.t, &value_names_) : dense_[k].explain(p.t);
+        report(i, p.t, p.v, &why);
+      } else {
+        report(i, p.t, p.v);
+      }
+    }
   }
 }
 

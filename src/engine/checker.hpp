@@ -16,6 +16,7 @@
 #include "engine/data/discrete_monitor.hpp"
 #include "engine/dense/monitor.hpp"
 #include "engine/discrete/monitor.hpp"
+#include "engine/explain.hpp"
 #include "engine/program.hpp"
 #include "engine/robust/dense_monitor.hpp"
 #include "engine/robust/monitor.hpp"
@@ -45,8 +46,14 @@ class Checker {
   // Robustness (quantitative) semantics instead of Boolean verdicts: call
   // before add_property; step_robust() then drives it.
   void enable_robustness();
-  // --explain: each violation's verdict carries why (discrete time).
+  // --explain: each violation's verdict carries why (discrete and dense
+  // time, data references too; not robustness values: throws
+  // std::invalid_argument after enable_robustness).
   void enable_explain();
+  // --explain with data references: names bound values by id (the decoder's
+  // io::BoundValues) in the sentences; without it they are named by the
+  // test and step that bound them.
+  void set_value_names(explain::ValueNames names) { value_names_ = std::move(names); }
   bool robustness() const { return robustness_; }
   // Data references: the most distinct values one quantified variable may
   // take (--max-data-values); beyond, step() throws data::DataLimitError.
@@ -96,6 +103,7 @@ class Checker {
   std::vector<dense::Monitor> dense_;
   bool robustness_ = false;
   bool explain_ = false;
+  explain::ValueNames value_names_;
   std::vector<robust::Monitor> robust_;
   std::vector<robust::DenseMonitor> robust_dense_;
   std::vector<double> last_robustness_;

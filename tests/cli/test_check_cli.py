@@ -164,6 +164,74 @@ def test_explain_names_the_deciding_subformulas_and_steps(rvc, tmp_path):
         {k: v for k, v in json.loads(l).items() if k != "explain"} for l in r.stdout.splitlines()]
 
 
+def test_explain_in_dense_time_and_with_data_references(rvc, tmp_path):
+    """--explain beyond discrete Boolean properties: dense time names intervals in seconds (a verdict
+    may start between two messages), data references name the value that decided. Sentences written
+    by hand; the verdicts are those without --explain; robustness values are refused."""
+    def explained(args, trace):
+        r = run(rvc, "check", "--explain", *args, trace)
+        assert r.returncode == 1, r.stderr
+        plain = run(rvc, "check", *args, trace)
+        assert plain.returncode == 1, plain.stderr
+        lines = [json.loads(l) for l in r.stdout.splitlines()]
+        assert [json.loads(l) for l in plain.stdout.splitlines()] == [
+            {k: v for k, v in l.items() if k != "explain"} for l in lines]
+        return lines
+
+    trace = write(tmp_path, "d.jsonl", [
+        '{"time":0,"emergency":false,"hazard":false,"brake":true}',
+        '{"time":1,"emergency":true,"hazard":true,"brake":false}',
+        '{"time":2,"emergency":true,"hazard":false,"brake":false}',
+        '{"time":4,"emergency":false,"hazard":false,"brake":false}'])
+    # once[0:1]{hazard} holds on [1, 3): the implication fails at 3, inside [2, 4); brake held on
+    # [0, 1), so once[0:1.5]{brake} ends at 2.5.
+    assert explained(["--dense", "--spec", "historically({emergency} -> once[0:1]{hazard})",
+                      "--spec", "once[0:1.5]{brake}"], trace) == [
+        {"time": 0, "property": "p1", "value": True},
+        {"time": 0, "property": "p2", "value": True},
+        {"time": 3, "property": "p1", "value": False, "explain": [
+            "(historically ({emergency} implies (once[:1] {hazard}))) is false: ({emergency} implies "
+            "(once[:1] {hazard})) failed at least once in [0, 3]",
+            "{emergency} is true throughout [2, 4)",
+            "(once[:1] {hazard}) is false: {hazard} never held in [2, 3]",
+            "{hazard} is false throughout [2, 4)"]},
+        {"time": 2.5, "property": "p2", "value": False, "explain": [
+            "(once[:1.5] {brake}) is false: {brake} never held in [1, 2.5]",
+            "{brake} is false throughout [2, 4)"]},
+    ]
+
+    ops = write(tmp_path, "ops.jsonl", [
+        '{"op":"open","file":"a.txt"}', '{"op":"close","file":"a.txt"}', '{"op":"close","file":"b.txt"}'])
+    body = ('(({op == "close"} and {file: *f}) implies (pre (once ({op == "open"} and {file: *f}))))')
+    b = "for f = the value of file at step 2: "
+    assert explained(["--spec", "forall[f]. ({op: close, file: *f} -> pre(once{op: open, file: *f}))"], ops) == [
+        {"time": 0, "property": "p1", "value": True},
+        {"time": 2, "property": "p1", "value": False, "explain": [
+            "(forall[f]. " + body + ") is false: " + body + " is false for f = the value of file at step 2",
+            b + '{op == "close"} is true at step 2',
+            b + "{file: *f} is true at step 2",
+            b + '(pre (once ({op == "open"} and {file: *f}))) is false: (once ({op == "open"} and {file: *f})) '
+                "was false at step 1"]},
+    ]
+
+    # Dense: "a" opened on [0, 0.5), closed at 1: once[0:1] of its opening ends at 1.5.
+    files = write(tmp_path, "files.jsonl", [
+        '{"time":0,"open":"a"}', '{"time":0.5,"open":"b"}', '{"time":1,"close":"a"}', '{"time":3}'])
+    a = "for f = the value of open at time 0: "
+    assert explained(["--dense", "--spec", "forall[f]. ({close: *f} -> once[0:1]{open: *f})"], files) == [
+        {"time": 0, "property": "p1", "value": True},
+        {"time": 1.5, "property": "p1", "value": False, "explain": [
+            "(forall[f]. ({close: *f} implies (once[:1] {open: *f}))) is false: ({close: *f} implies "
+            "(once[:1] {open: *f})) is false for f = the value of open at time 0",
+            a + "{close: *f} is true throughout [1, 3)",
+            a + "(once[:1] {open: *f}) is false: {open: *f} never held in [0.5, 1.5]",
+            a + "{open: *f} is false throughout [1, 3)"]},
+    ]
+
+    r = run(rvc, "check", "--robustness", "--explain", "--spec", "{x > 1}", trace)
+    assert r.returncode == 2 and "not --robustness values" in r.stderr, r.stderr
+
+
 def test_data_references_values_limits_and_refusals(rvc, tmp_path):
     """exists/forall from the command line: bound values keep their JSON type (3 and "3" differ,
     3 and 3.0 do not); a field that cannot be bound keeps the last value with a warning (strict:

@@ -4,12 +4,15 @@
 // holds on [t, next piece) and the last one until the segment's end.
 #include <gtest/gtest.h>
 
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "engine/dense/historically.hpp"
 #include "engine/dense/once.hpp"
 #include "engine/dense/signal.hpp"
 #include "engine/dense/since.hpp"
+#include "engine/explain.hpp"
 #include "test_util.hpp"
 
 namespace rvc::engine::dense {
@@ -266,6 +269,94 @@ TEST(DenseMonitor, EmitAllReportsEveryPiece) {
   std::vector<DenseMsg> msgs = {{0, {{"p", 1}}}, {1, {{"p", 1}}}, {2.5, {{"p", 1}}}};
   EXPECT_EQ(run_dense("{p}", msgs, 4), (TVs{{0, true}}));
   EXPECT_EQ(run_dense("{p}", msgs, 4, /*emit_all=*/true), (TVs{{0, true}, {1, true}, {2.5, true}}));
+}
+
+// ---------------------------------------------------------------- --explain
+
+// The explanations of `spec` over `msgs` (run_dense's trace): (time, sentences)
+// per violation start. Also checks that --explain changes no verdict.
+using Explained = std::vector<std::pair<double, std::vector<std::string>>>;
+Explained explain_dense(const std::string& spec, const std::vector<DenseMsg>& msgs, double end) {
+  Explained out;
+  TVs verdicts;
+  engine::Checker checker(engine::TimeModel::Dense, false, [&](const engine::Verdict& v) {
+    verdicts.emplace_back(v.time, v.value);
+    EXPECT_EQ(v.explanation != nullptr, !v.value) << "at " << v.time;  // every change to false, only those
+    if (v.explanation) out.emplace_back(v.time, *v.explanation);
+  });
+  checker.enable_explain();
+  checker.add_property({"p", spec});
+  std::vector<uint8_t> values(checker.atoms().size(), 0);
+  for (size_t i = 0; i < msgs.size(); ++i) {
+    for (const auto& [name, v] : msgs[i].values) values[test::atom_index(checker, name)] = static_cast<uint8_t>(v);
+    checker.step(msgs[i].time, i + 1 < msgs.size() ? msgs[i + 1].time : end, values.data());
+  }
+  EXPECT_EQ(verdicts, run_dense(spec, msgs, end)) << spec;
+  return out;
+}
+
+TEST(DenseExplain, BoundedOnceTurningFalseInsideASegment) {
+  // brake on [0, 1), then off: once[0:1.5] holds until 1 + 1.5 = 2.5, inside the segment [2, 5).
+  EXPECT_EQ(explain_dense("once[0:1.5]{brake}", {{0, {{"brake", 1}}}, {1, {{"brake", 0}}}, {2, {{"brake", 0}}}}, 5),
+            (Explained{{2.5,
+                        {"(once[:1.5] {brake}) is false: {brake} never held in [1, 2.5]",
+                         "{brake} is false throughout [2, 5)"}}}));
+}
+
+TEST(DenseExplain, HistoricallyOfAnImplicationFollowsTheFailingMoment) {
+  // e from 1 on; h on [1, 2) only: once[0:1]{h} holds on [1, 3), so the implication fails at 3 and
+  // historically with it; the reasons are read at 3, inside the segment [2, 4).
+  EXPECT_EQ(explain_dense("historically({e} -> once[0:1]{h})",
+                          {{0, {{"e", 0}, {"h", 0}}}, {1, {{"e", 1}, {"h", 1}}}, {2, {{"e", 1}, {"h", 0}}}}, 4),
+            (Explained{{3,
+                        {"(historically ({e} implies (once[:1] {h}))) is false: ({e} implies (once[:1] {h})) failed "
+                         "at least once in [0, 3]",
+                         "{e} is true throughout [2, 4)", "(once[:1] {h}) is false: {h} never held in [2, 3]",
+                         "{h} is false throughout [2, 4)"}}}));
+}
+
+TEST(DenseExplain, HistoricallyBoundedNamesItsWindow) {
+  // p false on [1, 2): historically[1:2]{p} reads [t-2, t-1], so it is false on [2, 4). Its
+  // lower bound is not 0: the cause lies in the window, not now, and the walk stops there.
+  EXPECT_EQ(explain_dense("historically[1:2]{p}", {{0, {{"p", 1}}}, {1, {{"p", 0}}}, {2, {{"p", 1}}}}, 6),
+            (Explained{{2, {"(historically[1:2] {p}) is false: {p} failed at least once in [0, 1]"}}}));
+  // Lower bound 0 and failing now: the atom that broke it.
+  EXPECT_EQ(explain_dense("historically[0:2]{p}", {{0, {{"p", 1}}}, {1.5, {{"p", 0}}}}, 3),
+            (Explained{{1.5,
+                        {"(historically[:2] {p}) is false: {p} failed at least once in [0, 1.5]",
+                         "{p} is false throughout [1.5, 3)"}}}));
+}
+
+TEST(DenseExplain, UnboundedOnceSinceAndBooleans) {
+  // q from 1 on, p never: the implication fails at 1; once{p} looks at everything since 0.
+  EXPECT_EQ(explain_dense("{q} -> once{p}", {{0, {{"q", 0}, {"p", 0}}}, {1, {{"q", 1}, {"p", 0}}}}, 3),
+            (Explained{{1,
+                        {"{q} is true throughout [1, 3)", "(once {p}) is false: {p} never held in [0, 1]",
+                         "{p} is false throughout [1, 3)"}}}));
+  // not/or/and: only the deciding operands (c, not b, for the false conjunction).
+  EXPECT_EQ(explain_dense("not {a} or ({b} and {c})",
+                          {{0, {{"a", 0}, {"b", 0}, {"c", 0}}}, {2, {{"a", 1}, {"b", 1}, {"c", 0}}}}, 3),
+            (Explained{{2, {"{a} is true throughout [2, 3)", "{c} is false throughout [2, 3)"}}}));
+  // since[1:2]: b on [0, 1) makes it true on [1, 3) while a holds. False at 0 (the window is
+  // still before time 0) and from 3 (b's moment left the window [t-2, t-1]).
+  EXPECT_EQ(explain_dense("{a} since[1:2] {b}", {{0, {{"a", 1}, {"b", 1}}}, {1, {{"a", 1}, {"b", 0}}}}, 5),
+            (Explained{{0, {"({a} since[1:2] {b}) is false: {b} never held at no time yet with {a} holding from "
+                            "then until now"}},
+                       {3, {"({a} since[1:2] {b}) is false: {b} never held in [1, 2] with {a} holding from then "
+                            "until now"}}}));
+  // The left side failing now ends since: the walk follows it.
+  EXPECT_EQ(explain_dense("{a} since {b}", {{0, {{"a", 1}, {"b", 1}}}, {1, {{"a", 1}, {"b", 0}}},
+                                            {2.25, {{"a", 0}, {"b", 0}}}}, 4),
+            (Explained{{2.25,
+                        {"({a} since {b}) is false: {b} never held in [0, 2.25] with {a} holding from then until now",
+                         "{a} is false throughout [2.25, 4)"}}}));
+}
+
+TEST(DenseExplain, ShortTimes) {
+  EXPECT_EQ(engine::explain::seconds(3.3 - 1.5), "1.8");
+  EXPECT_EQ(engine::explain::seconds(2.5), "2.5");
+  EXPECT_EQ(engine::explain::seconds(0), "0");
+  EXPECT_EQ(engine::explain::seconds(1795400000.125), "1795400000.125");
 }
 
 }  // namespace

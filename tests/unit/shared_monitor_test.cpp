@@ -32,8 +32,13 @@ TEST(Explain, AViolationSaysWhichSubformulasAndSteps) {
                 "once at steps 0..4",
                 "{e} is true at step 4", "(once[:1] {h}) is false: {h} never held at steps 3..4",
                 "{h} is false at step 4"}));
+  // Dense time and data references are explained too (dense_ops_test, data_monitor_test);
+  // robustness values are not yet: refused, not silently left without reasons.
   Checker dense(TimeModel::Dense, false, nullptr);
-  EXPECT_THROW(dense.enable_explain(), std::invalid_argument);
+  EXPECT_NO_THROW(dense.enable_explain());
+  Checker robust(TimeModel::Discrete, false, nullptr);
+  robust.enable_robustness();
+  EXPECT_THROW(robust.enable_explain(), std::invalid_argument);
 }
 
 }  // namespace

@@ -1,9 +1,11 @@
 #include "engine/data/dense_monitor.hpp"
 
+#include "engine/data/walker.hpp"
+
 namespace rvc::engine::data {
 
 DenseMonitor::DenseMonitor(const Program& program, const std::string& property, uint32_t max_values)
-    : code_(program.code), bindings_(program, property, max_values), signal_(program.code.size()),
+    : program_(program), code_(program.code), bindings_(program, property, max_values), signal_(program.code.size()),
       state_(program.code.size(), -1) {
   const std::vector<Mask> mask = free_variables(program);
   const Domains& domains = bindings_.domains();
@@ -48,7 +50,9 @@ void DenseMonitor::each_table(F&& f) {
 const dense::Signal& DenseMonitor::step(double begin, double end, const uint8_t* atoms, const uint32_t* bound) {
   bindings_.update(bound, [&](int var, uint32_t index, const Domains* before) {
     each_table([&](auto& table) { grow_table(table, bindings_.domains(), var, index, before); });
-  });
+  }, begin);
+  begin_ = begin;
+  end_ = end;
   const Domains& domains = bindings_.domains();
   for (size_t i = 0; i < code_.size(); ++i) {
     const Instr& in = code_[i];
@@ -116,6 +120,31 @@ const dense::Signal& DenseMonitor::step(double begin, double end, const uint8_t*
     }
   }
   return signal_.back().at(0);
+}
+
+namespace {
+
+class DenseWalker : public DataWalker {
+ public:
+  DenseWalker(const Program& program, double t, double begin, double end, const Bindings& bindings,
+              const std::vector<Table<dense::Signal>>& signal, const explain::ValueNames* names)
+      : DataWalker(program, true, t, bindings, names), signal_(signal), t_(t), begin_(begin), end_(end) {}
+
+ protected:
+  bool value(size_t i) const override { return dense::value_at(signal_[i].cells[offset(signal_[i])], t_); }
+  std::string held(size_t) const override {
+    return "throughout [" + explain::seconds(begin_) + ", " + explain::seconds(end_) + ")";
+  }
+
+ private:
+  const std::vector<Table<dense::Signal>>& signal_;
+  double t_, begin_, end_;
+};
+
+}  // namespace
+
+std::vector<std::string> DenseMonitor::explain(double t, const explain::ValueNames* names) const {
+  return DenseWalker(program_, t, begin_, end_, bindings_, signal_, names).run();
 }
 
 }  // namespace rvc::engine::data

@@ -15,6 +15,7 @@
 #include "engine/dense/once.hpp"
 #include "engine/dense/signal.hpp"
 #include "engine/dense/since.hpp"
+#include "engine/explain.hpp"
 #include "engine/program.hpp"
 
 namespace rvc::engine::data {
@@ -27,10 +28,19 @@ class DenseMonitor {
   // the property's value over it. Throws DataLimitError past max_values.
   const dense::Signal& step(double begin, double end, const uint8_t* atoms, const uint32_t* bound);
 
+  // --explain: call before the first step, so the values met can be named.
+  void enable_explain() { bindings_.keep_origins(); }
+  // After step(): why the property has its value at time t of the segment
+  // just stepped, naming sub-formulas, intervals and the values of the
+  // quantified variables that decide (DiscreteMonitor::explain).
+  std::vector<std::string> explain(double t, const explain::ValueNames* names = nullptr) const;
+
  private:
   template <class F>
   void each_table(F&& f);
 
+  Program program_;  // explain(): the sub-formulas' texts and variables
+  double begin_ = 0, end_ = 0;  // the segment last stepped
   std::vector<Instr> code_;
   Bindings bindings_;
   std::vector<Table<dense::Signal>> signal_;  // per instruction

@@ -1,5 +1,7 @@
 #include "engine/data/discrete_monitor.hpp"
 
+#include "engine/data/walker.hpp"
+
 namespace rvc::engine::data {
 namespace {
 
@@ -10,7 +12,8 @@ discrete::Step to_step(double v) {
 }  // namespace
 
 DiscreteMonitor::DiscreteMonitor(const Program& program, const std::string& property, uint32_t max_values)
-    : code_(program.code),
+    : program_(program),
+      code_(program.code),
       bindings_(program, property, max_values),
       value_(program.code.size()),
       set_(program.code.size(), 0),
@@ -57,7 +60,7 @@ bool DiscreteMonitor::step(const uint8_t* atoms, const uint32_t* bound) {
   // copied from "any other value" as it was after the previous step.
   bindings_.update(bound, [&](int var, uint32_t index, const Domains* before) {
     each_table([&](auto& table) { grow_table(table, bindings_.domains(), var, index, before); });
-  });
+  }, static_cast<double>(now_));
   const Domains& domains = bindings_.domains();
   const discrete::Step now = now_;
   for (size_t i = 0; i < code_.size(); ++i) {
@@ -135,6 +138,29 @@ size_t DiscreteMonitor::entries() const {
   size_t n = 0;
   for (const auto& t : value_) n += bindings_.domains().live(t.mask);
   return n;
+}
+
+namespace {
+
+class DiscreteWalker : public DataWalker {
+ public:
+  DiscreteWalker(const Program& program, discrete::Step now, const Bindings& bindings,
+                 const std::vector<Table<uint8_t>>& value, const explain::ValueNames* names)
+      : DataWalker(program, false, static_cast<double>(now), bindings, names), value_(value), now_(now) {}
+
+ protected:
+  bool value(size_t i) const override { return value_[i].cells[offset(value_[i])] != 0; }
+  std::string held(size_t) const override { return "at step " + std::to_string(now_); }
+
+ private:
+  const std::vector<Table<uint8_t>>& value_;
+  discrete::Step now_;
+};
+
+}  // namespace
+
+std::vector<std::string> DiscreteMonitor::explain(const explain::ValueNames* names) const {
+  return DiscreteWalker(program_, now_ - 1, bindings_, value_, names).run();
 }
 
 }  // namespace rvc::engine::data

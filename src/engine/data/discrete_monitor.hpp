@@ -22,6 +22,7 @@
 #include "engine/discrete/once.hpp"
 #include "engine/discrete/pre.hpp"
 #include "engine/discrete/since.hpp"
+#include "engine/explain.hpp"
 #include "engine/program.hpp"
 
 namespace rvc::engine::data {
@@ -38,10 +39,19 @@ class DiscreteMonitor {
 
   size_t entries() const;  // live table entries, all sub-formulas (tests, docs)
 
+  // --explain: call before the first step, so the values met can be named.
+  void enable_explain() { bindings_.keep_origins(); }
+  // After step(): why the property has its current value, as sentences naming
+  // sub-formulas, steps and the values of the quantified variables that
+  // decide ("for f = \"a.txt\": {file: *f} is true at step 3"). `names`
+  // names bound values by id (null: by where they were bound).
+  std::vector<std::string> explain(const explain::ValueNames* names = nullptr) const;
+
  private:
   template <class F>
   void each_table(F&& f);
 
+  Program program_;  // explain(): the sub-formulas' texts and variables
   std::vector<Instr> code_;
   Bindings bindings_;
   std::vector<Table<uint8_t>> value_;   // per instruction

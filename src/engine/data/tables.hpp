@@ -172,13 +172,28 @@ class Bindings {
   // Instruction i (a Bind): the index of the value its field holds now; 0: none yet.
   uint32_t index(size_t i) const { return index_of_instr_[i]; }
 
+  // --explain names the values that decide: where each index came from
+  // (kept only once keep_origins() was called, before the first update).
+  struct Origin {
+    uint32_t id = 0;     // the value (io::BoundValues id)
+    uint32_t instr = 0;  // the Bind instruction that met it first
+    double time = 0;     // the step (discrete) or time (dense) it was met at
+  };
+  void keep_origins() { origins_.assign(domains_.variables(), std::vector<Origin>(1)); }
+  // Variable v's index k (k >= 1); null when not kept.
+  const Origin* origin(int var, uint32_t k) const {
+    if (origins_.empty() || k >= origins_[static_cast<size_t>(var)].size()) return nullptr;
+    return &origins_[static_cast<size_t>(var)][k];
+  }
+
   // Reads this step's bound values (io::BoundValues ids per atom; null:
   // none). A value new to its variable gets an index first, and
   // `grow(var, index, before)` is called so every table over var can make
   // room (relayout when the capacity grew, then extend). Throws
   // DataLimitError past max_values.
+  // `time`: the step or time of the values, for origin().
   template <class Grow>
-  void update(const uint32_t* bound, Grow&& grow) {
+  void update(const uint32_t* bound, Grow&& grow, double time = 0) {
     for (size_t i = 0; i < code_.size(); ++i) {
       const Instr& in = code_[i];
       if (in.code != Code::Bind) continue;
@@ -190,6 +205,7 @@ class Bindings {
         const bool grew = domains_.add(in.var);
         if (grew) check_size(before);
         index.set(value, domains_.size(in.var) - 1);
+        if (!origins_.empty()) origins_[static_cast<size_t>(in.var)].push_back({value, static_cast<uint32_t>(i), time});
         grow(in.var, domains_.size(in.var) - 1, grew ? &before : nullptr);
       }
       index_of_instr_[i] = value ? index.find(value) : 0;
@@ -212,6 +228,7 @@ class Bindings {
   std::vector<ValueIndex> value_index_;  // per variable
   std::vector<uint32_t> index_of_instr_;
   std::vector<Mask> masks_;  // of the tables (free variables of each sub-formula)
+  std::vector<std::vector<Origin>> origins_;  // per variable, per index (--explain only)
 };
 
 // Makes room in `table` for variable var's new index (Bindings::update).

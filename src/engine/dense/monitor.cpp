@@ -1,8 +1,10 @@
 #include "engine/dense/monitor.hpp"
 
+#include "engine/explain.hpp"
+
 namespace rvc::engine::dense {
 
-Monitor::Monitor(const Program& program) : code_(program.code), signal_(program.code.size()), state_(program.code.size(), -1) {
+Monitor::Monitor(const Program& program) : program_(program), code_(program.code), signal_(program.code.size()), state_(program.code.size(), -1) {
   for (size_t i = 0; i < code_.size(); ++i) {
     const Instr& in = code_[i];
     double lo = in.bounds.lo, hi = in.bounds.hi;
@@ -30,6 +32,8 @@ Monitor::Monitor(const Program& program) : code_(program.code), signal_(program.
 }
 
 const Signal& Monitor::step(double begin, double end, const uint8_t* atoms) {
+  begin_ = begin;
+  end_ = end;
   const size_t n = code_.size();
   for (size_t i = 0; i < n; ++i) {
     const Instr& in = code_[i];
@@ -65,5 +69,28 @@ const Signal& Monitor::step(double begin, double end, const uint8_t* atoms) {
   }
   return signal_[n - 1];
 }
+
+namespace {
+
+// Each sub-formula's value at time t: read from its signal over the segment.
+class DenseWalker : public explain::Walker {
+ public:
+  DenseWalker(const Program& program, const std::vector<Signal>& signal, double t, double begin, double end)
+      : Walker(program, true, t), signal_(signal), t_(t), begin_(begin), end_(end) {}
+
+ protected:
+  bool value(size_t i) const override { return value_at(signal_[i], t_); }
+  std::string held(size_t) const override {  // an atom holds its message's value over the whole segment
+    return "throughout [" + explain::seconds(begin_) + ", " + explain::seconds(end_) + ")";
+  }
+
+ private:
+  const std::vector<Signal>& signal_;
+  double t_, begin_, end_;
+};
+
+}  // namespace
+
+std::vector<std::string> Monitor::explain(double t) const { return DenseWalker(program_, signal_, t, begin_, end_).run(); }
 
 }  // namespace rvc::engine::dense

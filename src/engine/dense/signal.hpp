@@ -43,6 +43,16 @@ struct BasicSignal {
 using Piece = BasicPiece<bool>;
 using Signal = BasicSignal<bool>;
 
+// The signal's value at time t of its segment (--explain reads sub-formulas so).
+inline bool value_at(const Signal& s, double t) {
+  bool v = !s.pieces.empty() && s.pieces.front().v;
+  for (const Piece& p : s.pieces) {
+    if (p.t > t) break;
+    v = p.v;
+  }
+  return v;
+}
+
 // Walks the pieces of two signals over the same segment in time order, calling
 // f(t, left_value, right_value) at each point where either changes.
 template <class V, class F>
