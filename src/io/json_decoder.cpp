@@ -142,6 +142,25 @@ JsonDecoder::JsonDecoder(const engine::AtomTable& atoms, DecoderOptions options)
   prepare(root_);
 }
 
+namespace {
+
+// The raw key at k equals `seen`'s key: it is followed by its closing quote.
+// Short keys compare as one masked 8-byte load: simdjson's buffers carry
+// SIMDJSON_PADDING readable bytes past the text, so the load stays inside.
+inline bool seen_key_is(const char* k, const std::string& key, uint64_t word, uint64_t mask) {
+  if (mask) {
+    uint64_t w;
+    std::memcpy(&w, k, sizeof w);
+    return (w & mask) == word;
+  }
+  const size_t n = key.size();
+  for (size_t i = 0; i < n; ++i)
+    if (k[i] != key[i]) return false;
+  return k[n] == '"';
+}
+
+}  // namespace
+
 void JsonDecoder::remember(KeyNode& node, size_t position, simdjson::ondemand::raw_json_string raw,
                            KeyNode* target) {
   // The raw key runs up to its closing quote (escaped quotes are preceded by a backslash).
@@ -151,7 +170,13 @@ void JsonDecoder::remember(KeyNode& node, size_t position, simdjson::ondemand::r
   // A key with escapes must take the unescaping path every time.
   if (std::memchr(k, '\\', n) != nullptr) return;
   if (node.by_position.size() <= position) node.by_position.resize(position + 1, KeyNode::Seen{"\x01", nullptr});
-  node.by_position[position] = KeyNode::Seen{std::string(k, n), target};
+  KeyNode::Seen seen{std::string(k, n), target};
+  if (n + 1 <= sizeof(uint64_t)) {
+    const std::string quoted = seen.key + '"';
+    std::memcpy(&seen.word, quoted.data(), quoted.size());  // the rest stays 0, as the mask's
+    seen.mask = quoted.size() == 8 ? ~uint64_t{0} : (uint64_t{1} << (8 * quoted.size())) - 1;
+  }
+  node.by_position[position] = std::move(seen);
 }
 
 void JsonDecoder::prepare(KeyNode& node) {
@@ -257,6 +282,7 @@ bool JsonDecoder::decode(simdjson::ondemand::object object, std::string& error, 
 
 bool JsonDecoder::decode_object(simdjson::ondemand::object object, KeyNode& node, std::string& error,
                                 std::vector<std::string>* warnings) {
+  const bool robustness = options_.robustness;
   size_t position = 0;
   for (auto field_result : object) {
     simdjson::ondemand::field field;
@@ -270,7 +296,7 @@ bool JsonDecoder::decode_object(simdjson::ondemand::object object, KeyNode& node
     bool known = false;
     if (position < node.by_position.size()) {
       const auto& seen = node.by_position[position];
-      if (key_is(raw, seen.key)) {
+      if (seen_key_is(reinterpret_cast<const char*>(raw.raw()), seen.key, seen.word, seen.mask)) {
         target = seen.target;
         known = true;
       }
@@ -297,6 +323,12 @@ bool JsonDecoder::decode_object(simdjson::ondemand::object object, KeyNode& node
         return invalid(error, err, key_text(raw));
       }
       continue;
+    }
+    // Fields tested only as Booleans or only as numbers (most): read here,
+    // without the general path's call; anything unexpected goes there.
+    if (target->kind != Kind::General && !robustness) {
+      target->seen = generation_;
+      if (fast_path(*target, value)) continue;
     }
     if (!decode_value(*target, value, error, warnings)) return false;
   }

@@ -77,6 +77,9 @@ class JsonDecoder {
     struct Seen {
       std::string key;
       KeyNode* target;
+      // Keys of up to 7 bytes: the key and its closing quote as one 8-byte
+      // word (little-endian) and the mask of its bytes, compared in one load.
+      uint64_t word = 0, mask = 0;
     };
     std::vector<Seen> by_position;
     Kind kind = Kind::General;

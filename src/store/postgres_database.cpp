@@ -7,12 +7,12 @@
 // about 4x faster than prepared INSERTs over a unix socket and far more over
 // a network, where each INSERT costs a round trip. Runs and properties need
 // ON CONFLICT / UPDATE, so they use prepared statements; there are few.
-#include <libpq-fe.h>
 
 #include <set>
 #include <string_view>
 
 #include "store/database.hpp"
+#include "store/libpq_loader.hpp"
 #include "store/schema.hpp"
 
 namespace rvc::store {
@@ -42,7 +42,7 @@ std::string one_line(const char* message) {
 std::string without_password(const std::string& conninfo) {
   const auto scheme = conninfo.find("://");
   if (scheme == std::string::npos) {
-    PQconninfoOption* options = PQconninfoParse(conninfo.c_str(), nullptr);
+    PQconninfoOption* options = libpq().PQconninfoParse(conninfo.c_str(), nullptr);
     if (!options) return "postgresql (unparsable conninfo)";
     std::string out;
     for (auto* o = options; o->keyword; ++o) {
@@ -50,7 +50,7 @@ std::string without_password(const std::string& conninfo) {
       if (!out.empty()) out += ' ';
       out += std::string(o->keyword) + "=" + o->val;
     }
-    PQconninfoFree(options);
+    libpq().PQconninfoFree(options);
     return out;
   }
   std::string base = conninfo, query;
@@ -134,17 +134,17 @@ class PostgresDatabase final : public Database {
     const char* keys[] = {"client_encoding", "connect_timeout", "keepalives_idle", "keepalives_interval",
                           "keepalives_count", "tcp_user_timeout", "dbname", nullptr};
     const char* values[] = {"UTF8", "10", "30", "10", "3", "60000", conninfo.c_str(), nullptr};
-    conn_ = PQconnectdbParams(keys, values, /*expand_dbname=*/1);
-    if (!conn_ || PQstatus(conn_) != CONNECTION_OK) {
-      const std::string what = conn_ ? one_line(PQerrorMessage(conn_)) : "out of memory";
-      PQfinish(conn_);
+    conn_ = libpq().PQconnectdbParams(keys, values, /*expand_dbname=*/1);
+    if (!conn_ || libpq().PQstatus(conn_) != CONNECTION_OK) {
+      const std::string what = conn_ ? one_line(libpq().PQerrorMessage(conn_)) : "out of memory";
+      libpq().PQfinish(conn_);
       conn_ = nullptr;
       throw DbError("cannot connect to " + describe() + ": " + what, true);
     }
     // NOTICEs ("relation already exists, skipping") would go to stderr.
-    PQsetNoticeProcessor(conn_, [](void*, const char*) {}, nullptr);
+    libpq().PQsetNoticeProcessor(conn_, [](void*, const char*) {}, nullptr);
   }
-  ~PostgresDatabase() override { PQfinish(conn_); }
+  ~PostgresDatabase() override { libpq().PQfinish(conn_); }
 
   void ensure_schema() override {
     // CREATE ... IF NOT EXISTS is not safe against a concurrent CREATE (one
@@ -174,8 +174,8 @@ class PostgresDatabase final : public Database {
   }
 
   bool reconnect() override {
-    PQreset(conn_);
-    if (PQstatus(conn_) != CONNECTION_OK) return false;
+    libpq().PQreset(conn_);
+    if (libpq().PQstatus(conn_) != CONNECTION_OK) return false;
     prepared_.clear();  // a new session has none of them
     try {
       ensure_schema();
@@ -188,19 +188,19 @@ class PostgresDatabase final : public Database {
   QueryResult query(const std::string& sql, const std::vector<std::string>& params) override {
     std::vector<const char*> values;
     for (const auto& p : params) values.push_back(p.c_str());
-    PGresult* res = PQexecParams(conn_, number_placeholders(sql).c_str(), static_cast<int>(values.size()), nullptr,
+    PGresult* res = libpq().PQexecParams(conn_, number_placeholders(sql).c_str(), static_cast<int>(values.size()), nullptr,
                                  values.data(), nullptr, nullptr, 0);
     check(res, "query");
     QueryResult out;
-    const int rows = PQntuples(res), columns = PQnfields(res);
+    const int rows = libpq().PQntuples(res), columns = libpq().PQnfields(res);
     out.reserve(rows);
     for (int r = 0; r < rows; ++r) {
       std::vector<std::string> row(columns);
       for (int c = 0; c < columns; ++c)
-        if (!PQgetisnull(res, r, c)) row[c].assign(PQgetvalue(res, r, c), PQgetlength(res, r, c));
+        if (!libpq().PQgetisnull(res, r, c)) row[c].assign(libpq().PQgetvalue(res, r, c), libpq().PQgetlength(res, r, c));
       out.push_back(std::move(row));
     }
-    PQclear(res);
+    libpq().PQclear(res);
     return out;
   }
 
@@ -214,8 +214,8 @@ class PostgresDatabase final : public Database {
     try {
       body();
     } catch (const DbError&) {
-      if (PQstatus(conn_) == CONNECTION_OK && PQtransactionStatus(conn_) != PQTRANS_IDLE)
-        PQclear(PQexec(conn_, "ROLLBACK"));
+      if (libpq().PQstatus(conn_) == CONNECTION_OK && libpq().PQtransactionStatus(conn_) != PQTRANS_IDLE)
+        libpq().PQclear(libpq().PQexec(conn_, "ROLLBACK"));
       throw;
     }
   }
@@ -225,36 +225,36 @@ class PostgresDatabase final : public Database {
   // failed the connection (SQLSTATE class 08): reconnect() may help then;
   // for any other error the same statement would fail again.
   DbError error(const std::string& what, const PGresult* res) const {
-    const char* state = res ? PQresultErrorField(res, PG_DIAG_SQLSTATE) : nullptr;
+    const char* state = res ? libpq().PQresultErrorField(res, PG_DIAG_SQLSTATE) : nullptr;
     const std::string code = state ? state : "";
-    const bool lost = PQstatus(conn_) != CONNECTION_OK || code.rfind("08", 0) == 0 || code.rfind("57P", 0) == 0;
-    const char* message = res && *PQresultErrorMessage(res) ? PQresultErrorMessage(res) : PQerrorMessage(conn_);
+    const bool lost = libpq().PQstatus(conn_) != CONNECTION_OK || code.rfind("08", 0) == 0 || code.rfind("57P", 0) == 0;
+    const char* message = res && *libpq().PQresultErrorMessage(res) ? libpq().PQresultErrorMessage(res) : libpq().PQerrorMessage(conn_);
     return DbError(what + ": " + one_line(message), lost);
   }
 
   // Throws (and frees `res`) unless `res` is a success.
   void check(PGresult* res, const std::string& what) const {
-    const auto status = res ? PQresultStatus(res) : PGRES_FATAL_ERROR;
+    const auto status = res ? libpq().PQresultStatus(res) : PGRES_FATAL_ERROR;
     if (status == PGRES_COMMAND_OK || status == PGRES_TUPLES_OK) return;
     DbError e = error(what, res);
-    PQclear(res);
+    libpq().PQclear(res);
     throw e;
   }
 
   void exec(const std::string& sql, const std::string& what) {
-    if (PQstatus(conn_) != CONNECTION_OK) throw DbError(what + ": not connected", true);
+    if (libpq().PQstatus(conn_) != CONNECTION_OK) throw DbError(what + ": not connected", true);
     // Several statements in one string: PQexec returns the last result, or
     // the first error (the rest is skipped).
-    PGresult* res = PQexec(conn_, sql.c_str());
+    PGresult* res = libpq().PQexec(conn_, sql.c_str());
     check(res, what);
-    PQclear(res);
+    libpq().PQclear(res);
   }
 
   void execute_each(Table table, const std::vector<const Row*>& rows) {
     if (rows.empty()) return;
     const std::string name = std::string("rvc_") + table_name(table);
     if (!prepared_.count(table)) {
-      check(PQprepare(conn_, name.c_str(), number_placeholders(insert_statement(table)).c_str(), 0, nullptr),
+      check(libpq().PQprepare(conn_, name.c_str(), number_placeholders(insert_statement(table)).c_str(), 0, nullptr),
             "prepare " + name);
       prepared_.insert(table);
     }
@@ -263,23 +263,23 @@ class PostgresDatabase final : public Database {
       const auto values = insert_values(*row);
       params.clear();
       for (const auto& v : values) params.push_back(v.c_str());
-      PGresult* res = PQexecPrepared(conn_, name.c_str(), static_cast<int>(params.size()), params.data(), nullptr,
+      PGresult* res = libpq().PQexecPrepared(conn_, name.c_str(), static_cast<int>(params.size()), params.data(), nullptr,
                                      nullptr, 0);
       check(res, std::string("write ") + table_name(table));
-      PQclear(res);
+      libpq().PQclear(res);
     }
   }
 
   void copy(Table table, const std::vector<const Row*>& rows) {
     if (rows.empty()) return;
     const std::string what = std::string("write ") + table_name(table) + " (COPY)";
-    PGresult* res = PQexec(conn_, copy_statement(table).c_str());
-    if (!res || PQresultStatus(res) != PGRES_COPY_IN) {
+    PGresult* res = libpq().PQexec(conn_, copy_statement(table).c_str());
+    if (!res || libpq().PQresultStatus(res) != PGRES_COPY_IN) {
       DbError e = error(what, res);
-      PQclear(res);
+      libpq().PQclear(res);
       throw e;
     }
-    PQclear(res);
+    libpq().PQclear(res);
     // Sent in pieces of about 1 MB: a batch of violations with long witness
     // windows need not be built in memory all at once.
     std::string data;
@@ -293,30 +293,30 @@ class PostgresDatabase final : public Database {
       }
       data += '\n';
       if (data.size() >= (1 << 20)) {
-        sent = PQputCopyData(conn_, data.data(), static_cast<int>(data.size())) == 1;
+        sent = libpq().PQputCopyData(conn_, data.data(), static_cast<int>(data.size())) == 1;
         data.clear();
         if (!sent) break;
       }
     }
-    if (sent && !data.empty()) sent = PQputCopyData(conn_, data.data(), static_cast<int>(data.size())) == 1;
-    PQputCopyEnd(conn_, sent ? nullptr : "rvc: sending the rows failed");
+    if (sent && !data.empty()) sent = libpq().PQputCopyData(conn_, data.data(), static_cast<int>(data.size())) == 1;
+    libpq().PQputCopyEnd(conn_, sent ? nullptr : "rvc: sending the rows failed");
     // The COPY's own result, then NULL; a dead connection gives an error
     // result too (never an endless PGRES_COPY_IN once the copy is ended).
     PGresult* outcome = nullptr;
-    while (PGresult* r = PQgetResult(conn_)) {
-      const bool stuck = PQresultStatus(r) == PGRES_COPY_IN;
+    while (PGresult* r = libpq().PQgetResult(conn_)) {
+      const bool stuck = libpq().PQresultStatus(r) == PGRES_COPY_IN;
       if (!outcome) outcome = r;
-      else PQclear(r);
+      else libpq().PQclear(r);
       if (stuck) break;
     }
-    if (outcome && PQresultStatus(outcome) == PGRES_COMMAND_OK) {
-      PQclear(outcome);
+    if (outcome && libpq().PQresultStatus(outcome) == PGRES_COMMAND_OK) {
+      libpq().PQclear(outcome);
       return;
     }
     // Still copying after the end was sent: the session is unusable.
-    const bool stuck = outcome && PQresultStatus(outcome) == PGRES_COPY_IN;
+    const bool stuck = outcome && libpq().PQresultStatus(outcome) == PGRES_COPY_IN;
     DbError e = stuck ? DbError(what + ": the server did not end the copy", true) : error(what, outcome);
-    PQclear(outcome);
+    libpq().PQclear(outcome);
     throw e;
   }
 

@@ -11,6 +11,20 @@ Step to_step(double v) { return v >= static_cast<double>(kForever) ? kForever : 
 constexpr size_t kMaxSlots = 65535;
 }  // namespace
 
+Monitor::Kind Monitor::kind_of(const Instr& in) {
+  const bool all = to_step(in.bounds.lo) == 0 && to_step(in.bounds.hi) >= kForever;  // [0, inf): the whole past
+  switch (in.code) {
+    case Code::And: return Kind::And;
+    case Code::Or: return Kind::Or;
+    case Code::Implies: return Kind::Implies;
+    case Code::Pre: return Kind::Pre;
+    case Code::Once: return all ? Kind::OnceAll : Kind::Once;
+    case Code::Historically: return all ? Kind::HistoricallyAll : Kind::Historically;
+    case Code::Since: return all ? Kind::SinceAll : Kind::Since;
+    default: throw std::logic_error("discrete::Monitor: not an operator");  // leaves, negations, references
+  }
+}
+
 Monitor::Monitor() : value_{0, 1} {}  // slot 0: false, slot 1: true
 
 bool Monitor::add(const Program& program) {
@@ -48,23 +62,26 @@ bool Monitor::add(const Program& program) {
       p.operand[i] = {found->second, 0};
       continue;
     }
-    Op op{in.code};
+    Op op{kind_of(in)};
     op.a = a.slot;
     op.negate_a = a.negate;
     op.b = b.slot;
     op.negate_b = b.negate;
     op.out = static_cast<uint16_t>(value_.size());
-    value_.push_back(0);
+    // A latch reads its own slot before writing it: historically starts true
+    // (nothing has failed yet), the others false. No other operator reads the
+    // slot before this one writes it in the same step.
+    value_.push_back(op.kind == Kind::HistoricallyAll ? 1 : 0);
     const Step lo = to_step(in.bounds.lo), hi = to_step(in.bounds.hi);
-    switch (in.code) {
-      case Code::Pre: op.slot = static_cast<uint16_t>(pre_.size()); pre_.emplace_back(); break;
-      case Code::Once: op.slot = static_cast<uint16_t>(once_.size()); once_.push_back(Once{lo, hi, {}}); break;
-      case Code::Historically:
+    switch (op.kind) {
+      case Kind::Pre: op.slot = static_cast<uint16_t>(pre_.size()); pre_.emplace_back(); break;
+      case Kind::Once: op.slot = static_cast<uint16_t>(once_.size()); once_.push_back(Once{lo, hi, {}}); break;
+      case Kind::Historically:
         op.slot = static_cast<uint16_t>(historically_.size());
         historically_.push_back(Historically{Once{lo, hi, {}}});
         break;
-      case Code::Since: op.slot = static_cast<uint16_t>(since_.size()); since_.push_back(Since{lo, hi, {}}); break;
-      default: break;
+      case Kind::Since: op.slot = static_cast<uint16_t>(since_.size()); since_.push_back(Since{lo, hi, {}}); break;
+      default: break;  // the Boolean connectives and the latches keep no state but their slot
     }
     ops_.push_back(op);
     shared_.emplace(key, op.out);
@@ -88,16 +105,19 @@ void Monitor::step(const uint8_t* atoms) {
   for (const Op *op = ops_.data(), *end = op + ops_.size(); op != end; ++op) {
     const uint8_t a = v[op->a] ^ op->negate_a;
     const uint8_t b = v[op->b] ^ op->negate_b;
+    const uint8_t last = v[op->out];  // this operator's output at the previous step
     uint8_t r;
-    switch (op->code) {
-      case Code::And: r = a & b; break;
-      case Code::Or: r = a | b; break;
-      case Code::Implies: r = (a ^ 1) | b; break;
-      case Code::Pre: r = pre[op->slot].update(a); break;
-      case Code::Once: r = once[op->slot].update(now, a); break;
-      case Code::Historically: r = historically[op->slot].update(now, a); break;
-      case Code::Since: r = since[op->slot].update(now, a, b); break;
-      default: r = 0; break;  // leaves and negations never become operators
+    switch (op->kind) {
+      case Kind::And: r = a & b; break;
+      case Kind::Or: r = a | b; break;
+      case Kind::Implies: r = (a ^ 1) | b; break;
+      case Kind::Pre: r = pre[op->slot].update(a); break;
+      case Kind::Once: r = once[op->slot].update(now, a); break;
+      case Kind::OnceAll: r = last | a; break;
+      case Kind::Historically: r = historically[op->slot].update(now, a); break;
+      case Kind::HistoricallyAll: r = last & a; break;
+      case Kind::Since: r = since[op->slot].update(now, a, b); break;
+      case Kind::SinceAll: r = b | (a & last); break;
     }
     v[op->out] = r;
   }

@@ -50,8 +50,12 @@ class Monitor {
     uint16_t slot = 0;
     uint8_t negate = 0;
   };
+  // What an operator does each step. Once, historically and since over all
+  // the past (no bounds) need no window: each is a latch over its own
+  // previous output, read back from its slot (`All` kinds).
+  enum class Kind : uint8_t { And, Or, Implies, Pre, Once, OnceAll, Historically, HistoricallyAll, Since, SinceAll };
   struct Op {
-    Code code;
+    Kind kind;
     uint8_t negate_a = 0, negate_b = 0;
     uint8_t unused = 0;
     uint16_t a = 0, b = 0;  // operand slots
@@ -66,6 +70,7 @@ class Monitor {
   // What makes two operators the same: code, operands, bounds.
   using Key = std::tuple<Code, uint16_t, uint8_t, uint16_t, uint8_t, double, double>;
 
+  static Kind kind_of(const Instr& in);
   bool read(Operand o) const { return value_[o.slot] ^ o.negate; }
   void why(const Property& p, size_t instruction, Step at, std::vector<std::string>& out) const;
 

@@ -1,5 +1,7 @@
 #include "transport/dds/dds_endpoint.hpp"
 
+#include "transport/dds/ddsc_loader.hpp"
+
 #include <dds/dds.h>
 #include <dds/ddsi/ddsi_cdrstream.h>
 #include <dds/ddsi/ddsi_serdata.h>
@@ -27,7 +29,7 @@ using dds::QosSpec;
 
 constexpr uint32_t kXcdr1 = 1;  // CycloneDDS's CDR_ENC_VERSION_1 (ddsi/q_protocol.h)
 
-std::string retcode(dds_return_t rc) { return dds_strretcode(rc); }
+std::string retcode(dds_return_t rc) { return ddsc().dds_strretcode(rc); }
 
 [[noreturn]] void fail(const std::string& what, dds_return_t rc) {
   throw std::runtime_error("dds: " + what + ": " + retcode(rc));
@@ -67,7 +69,7 @@ std::shared_ptr<Domain> acquire_domain(const DdsOptions& o) {
       return d;
     }
   }
-  dds_entity_t dom = dds_create_domain(static_cast<dds_domainid_t>(o.domain), config.c_str());
+  dds_entity_t dom = ddsc().dds_create_domain(static_cast<dds_domainid_t>(o.domain), config.c_str());
   if (dom < 0) {
     std::string where = o.config_file.empty() ? "interface '" + o.interface + "'" : "config '" + o.config_file + "'";
     if (dom == DDS_RETCODE_PRECONDITION_NOT_MET)
@@ -76,17 +78,17 @@ std::shared_ptr<Domain> acquire_domain(const DdsOptions& o) {
              " (CycloneDDS printed the reason above; does the interface exist?)",
          dom);
   }
-  dds_qos_t* pq = dds_create_qos();
-  dds_qset_entity_name(pq, "rvc");
-  dds_entity_t pp = dds_create_participant(static_cast<dds_domainid_t>(o.domain), pq, nullptr);
-  dds_delete_qos(pq);
+  dds_qos_t* pq = ddsc().dds_create_qos();
+  ddsc().dds_qset_entity_name(pq, "rvc");
+  dds_entity_t pp = ddsc().dds_create_participant(static_cast<dds_domainid_t>(o.domain), pq, nullptr);
+  ddsc().dds_delete_qos(pq);
   if (pp < 0) {
-    dds_delete(dom);
+    ddsc().dds_delete(dom);
     fail("cannot create participant in domain " + std::to_string(o.domain), pp);
   }
   auto d = std::shared_ptr<Domain>(new Domain{o.domain, config, dom, pp}, [](Domain* p) {
     std::lock_guard lock(g_domains_mutex);  // nobody re-creates the id while it is being deleted
-    dds_delete(p->domain);
+    ddsc().dds_delete(p->domain);
     delete p;
   });
   g_domains[o.domain] = d;
@@ -96,25 +98,25 @@ std::shared_ptr<Domain> acquire_domain(const DdsOptions& o) {
 // Reliability, history and durability from --qos; readers use the same
 // policies (a reader's "reliable" requests a reliable writer).
 dds_qos_t* make_qos(const QosSpec& q, const std::string& partition, bool for_group) {
-  dds_qos_t* qos = dds_create_qos();
+  dds_qos_t* qos = ddsc().dds_create_qos();
   if (for_group) {
-    if (!partition.empty()) dds_qset_partition1(qos, partition.c_str());
+    if (!partition.empty()) ddsc().dds_qset_partition1(qos, partition.c_str());
     return qos;
   }
-  dds_qset_reliability(qos, q.reliable ? DDS_RELIABILITY_RELIABLE : DDS_RELIABILITY_BEST_EFFORT, to_dds(q.max_blocking));
+  ddsc().dds_qset_reliability(qos, q.reliable ? DDS_RELIABILITY_RELIABLE : DDS_RELIABILITY_BEST_EFFORT, to_dds(q.max_blocking));
   if (q.keep_last > 0)
-    dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, q.keep_last);
+    ddsc().dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, q.keep_last);
   else
-    dds_qset_history(qos, DDS_HISTORY_KEEP_ALL, DDS_LENGTH_UNLIMITED);
-  dds_qset_durability(qos, q.transient_local ? DDS_DURABILITY_TRANSIENT_LOCAL : DDS_DURABILITY_VOLATILE);
+    ddsc().dds_qset_history(qos, DDS_HISTORY_KEEP_ALL, DDS_LENGTH_UNLIMITED);
+  ddsc().dds_qset_durability(qos, q.transient_local ? DDS_DURABILITY_TRANSIENT_LOCAL : DDS_DURABILITY_VOLATILE);
   if (q.transient_local) {
     // What a transient-local writer keeps for late joiners is governed by the
     // durability-service history (default keep-last 1): make it the history.
-    dds_qset_durability_service(qos, 0, q.keep_last > 0 ? DDS_HISTORY_KEEP_LAST : DDS_HISTORY_KEEP_ALL,
+    ddsc().dds_qset_durability_service(qos, 0, q.keep_last > 0 ? DDS_HISTORY_KEEP_LAST : DDS_HISTORY_KEEP_ALL,
                                 q.keep_last > 0 ? q.keep_last : DDS_LENGTH_UNLIMITED, DDS_LENGTH_UNLIMITED,
                                 DDS_LENGTH_UNLIMITED, DDS_LENGTH_UNLIMITED);
   }
-  dds_qset_resource_limits(qos, DDS_LENGTH_UNLIMITED, DDS_LENGTH_UNLIMITED, DDS_LENGTH_UNLIMITED);
+  ddsc().dds_qset_resource_limits(qos, DDS_LENGTH_UNLIMITED, DDS_LENGTH_UNLIMITED, DDS_LENGTH_UNLIMITED);
   return qos;
 }
 
@@ -142,23 +144,23 @@ struct Endpoint {
       ros_type = std::make_unique<dds::RuntimeTopicType>(*o.ros_type);
       desc = ros_type->descriptor();
     }
-    topic = dds_create_topic(dom->participant, desc, name.c_str(), nullptr, nullptr);
+    topic = ddsc().dds_create_topic(dom->participant, desc, name.c_str(), nullptr, nullptr);
     if (topic < 0)
       fail("cannot create topic '" + name + "' (" + desc->m_typename +
                (topic == DDS_RETCODE_PRECONDITION_NOT_MET ? "; this process already has the topic with another type)" : ")"),
            topic);
     dds_qos_t* gq = make_qos(qos, o.partition, true);
-    group = publisher ? dds_create_publisher(dom->participant, gq, nullptr)
-                      : dds_create_subscriber(dom->participant, gq, nullptr);
-    dds_delete_qos(gq);
+    group = publisher ? ddsc().dds_create_publisher(dom->participant, gq, nullptr)
+                      : ddsc().dds_create_subscriber(dom->participant, gq, nullptr);
+    ddsc().dds_delete_qos(gq);
     if (group < 0) {
-      dds_delete(topic);
+      ddsc().dds_delete(topic);
       fail(std::string("cannot create ") + (publisher ? "publisher" : "subscriber") + " for '" + name + "'", group);
     }
   }
   ~Endpoint() {
-    if (group > 0) dds_delete(group);
-    if (topic > 0) dds_delete(topic);
+    if (group > 0) ddsc().dds_delete(group);
+    if (topic > 0) ddsc().dds_delete(topic);
   }
   Endpoint(const Endpoint&) = delete;
   Endpoint& operator=(const Endpoint&) = delete;
@@ -170,23 +172,23 @@ template <typename Status, typename Get>
 bool wait_status(dds_entity_t participant, dds_entity_t entity, uint32_t mask, Get get, size_t n,
                  std::chrono::milliseconds timeout) {
   const auto deadline = std::chrono::steady_clock::now() + timeout;
-  dds_set_status_mask(entity, mask);
-  dds_entity_t ws = dds_create_waitset(participant);
+  ddsc().dds_set_status_mask(entity, mask);
+  dds_entity_t ws = ddsc().dds_create_waitset(participant);
   if (ws < 0) fail("cannot create waitset", ws);
-  dds_waitset_attach(ws, entity, entity);
+  ddsc().dds_waitset_attach(ws, entity, entity);
   bool ok = false;
   for (;;) {
     Status st{};
     if (dds_return_t rc = get(entity, &st); rc < 0) {
-      dds_delete(ws);
+      ddsc().dds_delete(ws);
       fail("cannot read matched status", rc);
     }
     if (st.current_count >= n) { ok = true; break; }
     auto left = deadline - std::chrono::steady_clock::now();
     if (left <= std::chrono::steady_clock::duration::zero()) break;
-    dds_waitset_wait(ws, nullptr, 0, std::chrono::duration_cast<std::chrono::nanoseconds>(left).count());
+    ddsc().dds_waitset_wait(ws, nullptr, 0, std::chrono::duration_cast<std::chrono::nanoseconds>(left).count());
   }
-  dds_delete(ws);
+  ddsc().dds_delete(ws);
   return ok;
 }
 
@@ -210,25 +212,25 @@ struct DdsSource::Impl {
 
   Impl(const std::string& topic, const DdsOptions& o) : ep(topic, o, false), on_receive_thread(o.deliver_on_receive_thread) {
     dds_qos_t* rq = make_qos(ep.qos, o.partition, false);
-    reader = dds_create_reader(ep.group, ep.topic, rq, nullptr);
-    dds_delete_qos(rq);
+    reader = ddsc().dds_create_reader(ep.group, ep.topic, rq, nullptr);
+    ddsc().dds_delete_qos(rq);
     if (reader < 0) fail("cannot create reader on '" + ep.name + "'", reader);
     if (on_receive_thread) return;
-    readcond = dds_create_readcondition(reader, DDS_ANY_STATE);
-    guard = dds_create_guardcondition(ep.dom->participant);
-    waitset = dds_create_waitset(ep.dom->participant);
+    readcond = ddsc().dds_create_readcondition(reader, DDS_ANY_STATE);
+    guard = ddsc().dds_create_guardcondition(ep.dom->participant);
+    waitset = ddsc().dds_create_waitset(ep.dom->participant);
     if (readcond < 0 || guard < 0 || waitset < 0) {
       for (dds_entity_t e : {waitset, guard, reader})
-        if (e > 0) dds_delete(e);
+        if (e > 0) ddsc().dds_delete(e);
       fail("cannot create waitset for '" + ep.name + "'", DDS_RETCODE_ERROR);
     }
-    dds_waitset_attach(waitset, readcond, readcond);
-    dds_waitset_attach(waitset, guard, guard);
+    ddsc().dds_waitset_attach(waitset, readcond, readcond);
+    ddsc().dds_waitset_attach(waitset, guard, guard);
   }
   ~Impl() {
-    if (waitset > 0) dds_delete(waitset);
-    if (guard > 0) dds_delete(guard);
-    dds_delete(reader);  // also deletes readcond and the listener
+    if (waitset > 0) ddsc().dds_delete(waitset);
+    if (guard > 0) ddsc().dds_delete(guard);
+    ddsc().dds_delete(reader);  // also deletes readcond and the listener
   }
 
   void deliver(const void* sample, const dds_sample_info_t& info) {
@@ -265,7 +267,7 @@ struct DdsSource::Impl {
     std::string bytes;
     for (;;) {
       if (stop_requested.load()) return false;
-      dds_return_t n = dds_takecdr(from, samples, kBatch, infos, DDS_ANY_STATE);
+      dds_return_t n = ddsc().dds_takecdr(from, samples, kBatch, infos, DDS_ANY_STATE);
       if (n <= 0) return true;
       bool ok = true;
       for (dds_return_t i = 0; i < n; ++i) {
@@ -310,7 +312,7 @@ struct DdsSource::Impl {
     for (;;) {
       if (stop_requested.load()) return false;
       samples[0] = nullptr;  // loan the sample buffers from the reader
-      dds_return_t n = dds_take(from, samples, infos, kBatch, kBatch);
+      dds_return_t n = ddsc().dds_take(from, samples, infos, kBatch, kBatch);
       if (n <= 0) return true;
       bool ok = true;
       for (dds_return_t i = 0; i < n && ok && !stop_requested.load(); ++i) {
@@ -325,7 +327,7 @@ struct DdsSource::Impl {
           ok = false;
         }
       }
-      dds_return_loan(from, samples, n);
+      ddsc().dds_return_loan(from, samples, n);
       if (!ok) {
         stop_requested = true;
         return false;
@@ -347,7 +349,7 @@ struct DdsSource::Impl {
   // Thread mode: the source's own thread sleeps on a waitset.
   void run() {
     while (!stop_requested.load()) {
-      dds_waitset_wait(waitset, nullptr, 0, DDS_INFINITY);
+      ddsc().dds_waitset_wait(waitset, nullptr, 0, DDS_INFINITY);
       if (!take_all(readcond)) return;
     }
   }
@@ -364,10 +366,10 @@ void DdsSource::start(FrameHandler handler) {
     impl_->thread = std::thread([this] { impl_->run(); });
     return;
   }
-  dds_listener_t* l = dds_create_listener(impl_.get());
-  dds_lset_data_available(l, &Impl::on_data_available);
-  dds_return_t rc = dds_set_listener(impl_->reader, l);
-  dds_delete_listener(l);
+  dds_listener_t* l = ddsc().dds_create_listener(impl_.get());
+  ddsc().dds_lset_data_available(l, &Impl::on_data_available);
+  dds_return_t rc = ddsc().dds_set_listener(impl_->reader, l);
+  ddsc().dds_delete_listener(l);
   if (rc < 0) fail("cannot set the data listener on '" + impl_->ep.name + "'", rc);
   // Samples that arrived before the listener was set raised no callback.
   impl_->drain();
@@ -381,12 +383,12 @@ void DdsSource::stop() {
     // Called from the handler: the drain stops after it returns.
     if (m.draining.load() == std::this_thread::get_id()) return;
     if (m.started) {
-      dds_set_listener(m.reader, nullptr);  // waits for a listener call in progress
+      ddsc().dds_set_listener(m.reader, nullptr);  // waits for a listener call in progress
       std::lock_guard lock(m.drain_mu);     // and for start()'s own drain
     }
     return;
   }
-  dds_set_guardcondition(m.guard, true);
+  ddsc().dds_set_guardcondition(m.guard, true);
   if (m.thread.joinable()) {
     if (m.thread.get_id() == std::this_thread::get_id())
       m.thread.detach();  // called from the handler: the loop exits after it returns
@@ -398,7 +400,7 @@ void DdsSource::stop() {
 bool DdsSource::wait_matched(size_t n, std::chrono::milliseconds timeout) {
   return wait_status<dds_subscription_matched_status_t>(impl_->ep.dom->participant, impl_->reader,
                                                         DDS_SUBSCRIPTION_MATCHED_STATUS,
-                                                        dds_get_subscription_matched_status, n, timeout);
+                                                        ddsc().dds_get_subscription_matched_status, n, timeout);
 }
 
 const std::string& DdsSource::dds_topic() const { return impl_->ep.name; }
@@ -418,15 +420,15 @@ struct DdsSink::Impl {
                 "'. Subscribers must use the same domain, and a config pinned to the same interface "
                 "(rvc dds-config writes one for CYCLONEDDS_URI)";
     dds_qos_t* wq = make_qos(ep.qos, o.partition, false);
-    writer = dds_create_writer(ep.group, ep.topic, wq, nullptr);
-    dds_delete_qos(wq);
+    writer = ddsc().dds_create_writer(ep.group, ep.topic, wq, nullptr);
+    ddsc().dds_delete_qos(wq);
     if (writer < 0) fail("cannot create writer on '" + ep.name + "'", writer);
   }
   ~Impl() {
     // Let reliable readers catch up (bounded), then delete the writer.
     auto limit = ep.qos.max_blocking.count() < 0 ? std::chrono::milliseconds(30000) : ep.qos.max_blocking;
-    dds_wait_for_acks(writer, to_dds(limit));
-    dds_delete(writer);
+    ddsc().dds_wait_for_acks(writer, to_dds(limit));
+    ddsc().dds_delete(writer);
   }
 
   // Typed topics: the payload is a CDR sample (header + XCDR1). CycloneDDS
@@ -442,17 +444,17 @@ struct DdsSink::Impl {
     std::memcpy(aligned.data(), payload.data() + 4, size);
     uint32_t used = 0;
     const bool swap = little != (__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__);
-    if (!dds_stream_normalize_data(reinterpret_cast<char*>(aligned.data()), &used, size, swap, kXcdr1,
+    if (!ddsc().dds_stream_normalize_data(reinterpret_cast<char*>(aligned.data()), &used, size, swap, kXcdr1,
                                    type.ops().data()))
       throw std::invalid_argument("dds: payload is not a valid CDR sample of " +
                                   std::string(type.descriptor()->m_typename));
     std::vector<uint64_t> sample(type.sample_size() / 8 + 1, 0);
     dds_istream_t in;
-    dds_istream_init(&in, size, aligned.data(), kXcdr1);
-    dds_stream_read(&in, reinterpret_cast<char*>(sample.data()), type.ops().data());
-    dds_istream_fini(&in);
-    const dds_return_t rc = dds_write(writer, sample.data());
-    dds_stream_free_sample(sample.data(), type.ops().data());
+    ddsc().dds_istream_init(&in, size, aligned.data(), kXcdr1);
+    ddsc().dds_stream_read(&in, reinterpret_cast<char*>(sample.data()), type.ops().data());
+    ddsc().dds_istream_fini(&in);
+    const dds_return_t rc = ddsc().dds_write(writer, sample.data());
+    ddsc().dds_stream_free_sample(sample.data(), type.ops().data());
     return rc;
   }
 
@@ -462,10 +464,10 @@ struct DdsSink::Impl {
       rc = write_typed(payload);
     } else if ((scratch.assign(payload), ep.frame_type)) {
       rvc_msgs_msg_dds__Frame_ s{seq, scratch.data()};
-      rc = dds_write(writer, &s);
+      rc = ddsc().dds_write(writer, &s);
     } else {
       std_msgs_msg_dds__String_ s{scratch.data()};
-      rc = dds_write(writer, &s);
+      rc = ddsc().dds_write(writer, &s);
     }
     if (rc == DDS_RETCODE_TIMEOUT)
       throw std::runtime_error("dds: write on '" + ep.name + "' blocked longer than max-blocking=" +
@@ -500,30 +502,30 @@ void DdsSink::put(std::string_view payload, uint64_t seq) {
 void DdsSink::put_eos(uint64_t last_seq) {
   std::lock_guard lock(impl_->mu);
   if (impl_->ep.ros_type) {  // a typed topic has no end-of-stream marker
-    dds_write_flush(impl_->writer);
+    ddsc().dds_write_flush(impl_->writer);
     return;
   }
   impl_->write(dds::format_eos(EosMarker{last_seq, impl_->written}), last_seq);
-  dds_write_flush(impl_->writer);  // with write batching the marker would wait for a full packet
+  ddsc().dds_write_flush(impl_->writer);  // with write batching the marker would wait for a full packet
 }
 
 void DdsSink::idle() {
   std::lock_guard lock(impl_->mu);
-  dds_write_flush(impl_->writer);
+  ddsc().dds_write_flush(impl_->writer);
 }
 
 bool DdsSink::wait_matched(size_t n, std::chrono::milliseconds timeout) {
   return wait_status<dds_publication_matched_status_t>(impl_->ep.dom->participant, impl_->writer,
                                                        DDS_PUBLICATION_MATCHED_STATUS,
-                                                       dds_get_publication_matched_status, n, timeout);
+                                                       ddsc().dds_get_publication_matched_status, n, timeout);
 }
 
 void DdsSink::flush() {
   {
     std::lock_guard lock(impl_->mu);
-    dds_write_flush(impl_->writer);
+    ddsc().dds_write_flush(impl_->writer);
   }
-  dds_return_t rc = dds_wait_for_acks(impl_->writer, to_dds(impl_->ep.qos.max_blocking));
+  dds_return_t rc = ddsc().dds_wait_for_acks(impl_->writer, to_dds(impl_->ep.qos.max_blocking));
   if (rc == DDS_RETCODE_TIMEOUT)
     throw std::runtime_error("dds: readers of '" + impl_->ep.name + "' did not acknowledge within max-blocking=" +
                              describe(impl_->ep.qos.max_blocking));
