@@ -2,6 +2,8 @@
 
 #include <charconv>
 
+#include "io/json_writer.hpp"
+
 namespace rvc::io {
 
 uint32_t BoundValues::id(const FieldValue& v) {
@@ -23,7 +25,20 @@ uint32_t BoundValues::id(const FieldValue& v) {
     default: return 0;
   }
   auto [it, added] = ids_.try_emplace(key_, static_cast<uint32_t>(ids_.size() + 1));
+  if (added) keys_.push_back(&it->first);
   return it->second;
+}
+
+std::string BoundValues::json(uint32_t id) const {
+  if (id == 0 || id > keys_.size()) return "";
+  const std::string& key = *keys_[id - 1];  // kind letter, then the text
+  std::string out;
+  switch (key[0]) {
+    case 's': append_json_string(out, std::string_view(key).substr(1)); break;
+    case 'n': out = key.substr(1); break;
+    default: out = key == "b1" ? "true" : "false"; break;
+  }
+  return out;
 }
 
 }  // namespace rvc::io

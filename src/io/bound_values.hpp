@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <string>
 #include <unordered_map>
+#include <vector>
 
 #include "io/field_tests.hpp"
 
@@ -20,9 +21,13 @@ class BoundValues {
   // an array, an object).
   uint32_t id(const FieldValue& value);
   size_t size() const { return ids_.size(); }
+  // The value with this id as JSON text ("\"a.txt\"", 3, true), for --explain;
+  // "" for an id never given out.
+  std::string json(uint32_t id) const;
 
  private:
   std::unordered_map<std::string, uint32_t> ids_;
+  std::vector<const std::string*> keys_;  // by id - 1: the map's own keys (nodes do not move)
   std::string key_;  // reused: no allocation for a value seen before
 };
 

@@ -57,6 +57,8 @@ class CdrDecoder {
   const double* margins() const { return margin_.data(); }
   // Data references: per atom, the id of the value bound last (as JsonDecoder::bound).
   const uint32_t* bound() const { return bound_.empty() ? nullptr : bound_.data(); }
+  // The values data references bound so far (--explain names them).
+  const BoundValues& bound_values() const { return bound_ids_; }
   double time() const { return time_; }
 
   // "time" -> the field dense time reads in a message of this type when the

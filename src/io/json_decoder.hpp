@@ -52,6 +52,8 @@ class JsonDecoder {
   // With DecoderOptions::robustness: each test's robustness (io::test_margin);
   // -inf for a field never seen, as Reelay starts.
   const double* margins() const { return margin_.data(); }
+  // The values data references bound so far (--explain names them).
+  const BoundValues& bound_values() const { return bound_ids_; }
   double time() const { return time_; }
 
  private:

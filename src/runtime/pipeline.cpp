@@ -56,6 +56,13 @@ Pipeline::Pipeline(const std::vector<engine::PropertySpec>& properties, const Pi
                                           options.strict, options.robustness}),
       batch_reader_(*this, options.max_message_size) {
   make_typed_decoder();
+  // --explain names the values a data reference decided on by their JSON
+  // text; the decoders assign their ids. (A Pipeline never moves: its
+  // reader already holds `this`.)
+  if (options.explain && checker_.has_data_references())
+    checker_.set_value_names([this](uint32_t id) {
+      return typed_ ? typed_->bound_values().json(id) : decoder_.bound_values().json(id);
+    });
 }
 
 void Pipeline::make_typed_decoder() {

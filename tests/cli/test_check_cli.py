@@ -203,11 +203,11 @@ def test_explain_in_dense_time_and_with_data_references(rvc, tmp_path):
     ops = write(tmp_path, "ops.jsonl", [
         '{"op":"open","file":"a.txt"}', '{"op":"close","file":"a.txt"}', '{"op":"close","file":"b.txt"}'])
     body = ('(({op == "close"} and {file: *f}) implies (pre (once ({op == "open"} and {file: *f}))))')
-    b = "for f = the value of file at step 2: "
+    b = 'for f = "b.txt": '
     assert explained(["--spec", "forall[f]. ({op: close, file: *f} -> pre(once{op: open, file: *f}))"], ops) == [
         {"time": 0, "property": "p1", "value": True},
         {"time": 2, "property": "p1", "value": False, "explain": [
-            "(forall[f]. " + body + ") is false: " + body + " is false for f = the value of file at step 2",
+            "(forall[f]. " + body + ") is false: " + body + ' is false for f = "b.txt"',
             b + '{op == "close"} is true at step 2',
             b + "{file: *f} is true at step 2",
             b + '(pre (once ({op == "open"} and {file: *f}))) is false: (once ({op == "open"} and {file: *f})) '
@@ -217,12 +217,12 @@ def test_explain_in_dense_time_and_with_data_references(rvc, tmp_path):
     # Dense: "a" opened on [0, 0.5), closed at 1: once[0:1] of its opening ends at 1.5.
     files = write(tmp_path, "files.jsonl", [
         '{"time":0,"open":"a"}', '{"time":0.5,"open":"b"}', '{"time":1,"close":"a"}', '{"time":3}'])
-    a = "for f = the value of open at time 0: "
+    a = 'for f = "a": '
     assert explained(["--dense", "--spec", "forall[f]. ({close: *f} -> once[0:1]{open: *f})"], files) == [
         {"time": 0, "property": "p1", "value": True},
         {"time": 1.5, "property": "p1", "value": False, "explain": [
             "(forall[f]. ({close: *f} implies (once[:1] {open: *f}))) is false: ({close: *f} implies "
-            "(once[:1] {open: *f})) is false for f = the value of open at time 0",
+            '(once[:1] {open: *f})) is false for f = "a"',
             a + "{close: *f} is true throughout [1, 3)",
             a + "(once[:1] {open: *f}) is false: {open: *f} never held in [0.5, 1.5]",
             a + "{open: *f} is false throughout [1, 3)"]},

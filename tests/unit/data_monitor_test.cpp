@@ -170,6 +170,22 @@ TEST(BoundValues, KeepTheirJsonType) {
   EXPECT_EQ(ids.size(), 4u);
 }
 
+// --explain names a value by its JSON text, as it would appear in a message.
+TEST(BoundValues, NameTheirValuesAsJson) {
+  io::BoundValues ids;
+  using io::FieldValue, io::ValueKind;
+  const uint32_t s = ids.id(FieldValue{ValueKind::String, false, 0, "a \"b\"\\c"});
+  const uint32_t n = ids.id(FieldValue{ValueKind::Number, false, 2.5, {}});
+  const uint32_t f = ids.id(FieldValue{ValueKind::Bool, false, 0, {}});
+  const uint32_t digits = ids.id(FieldValue{ValueKind::String, false, 0, "3"});
+  EXPECT_EQ(ids.json(s), R"("a \"b\"\\c")");
+  EXPECT_EQ(ids.json(n), "2.5");
+  EXPECT_EQ(ids.json(f), "false");
+  EXPECT_EQ(ids.json(digits), "\"3\"");  // the string, not the number
+  EXPECT_EQ(ids.json(0), "");
+  EXPECT_EQ(ids.json(99), "");
+}
+
 // ---------------------------------------------------------------- --explain
 
 // A Checker with --explain over messages given as key -> value id (0: the
