@@ -211,6 +211,7 @@ def main():
         t_rvc, rss_rvc, rc = best_of([rvc, "check", "--spec", spec, path], args.reps)
         t_dec, rss_dec, _ = best_of([rvc, "check", "--parse-only", "--spec", spec, path], args.reps)
         t_floor, rss_floor, _ = best_of([floor, path], args.reps)
+        t_vfloor, _, _ = best_of([floor, "--validate", path], args.reps)
         r_rate = reelay_rate(path, spec, args.reelay_events) if args.reelay_events else float("nan")
         t_cpp = rss_cpp = float("nan")
         cpp_note = ""
@@ -235,11 +236,12 @@ def main():
                     cpp_note = f"  Reelay C++ {t_cpp*1e3:7.1f} ms ({t_cpp/t_rvc:4.2f}x)"
         rows.append(dict(property=name, family=family, bound=bound, rvc_ms=t_rvc * 1e3, rvc_rss_mb=rss_rvc,
                          decode_ms=t_dec * 1e3, floor_ms=t_floor * 1e3, floor_rss_mb=rss_floor,
+                         vfloor_ms=t_vfloor * 1e3,
                          rvc_mev_s=args.steps / t_rvc / 1e6, reelay_cpp_ms=t_cpp * 1e3, reelay_cpp_rss_mb=rss_cpp,
                          reelay_py_mev_s=r_rate / 1e6, verdict_rc=rc))
         py_note = f"  reelay-py {r_rate/1e6:6.3f} Mev/s" if args.reelay_events else ""
         print(f"[{n:2d}/{total}] {name:14s} rvc {t_rvc*1e3:7.1f} ms  decode-only {t_dec*1e3:7.1f} ms  "
-              f"simdjson floor {t_floor*1e3:7.1f} ms  rss {rss_rvc:5.1f} MB{cpp_note}{py_note}", flush=True)
+              f"simdjson floor {t_floor*1e3:7.1f} ms (validating {t_vfloor*1e3:7.1f})  rss {rss_rvc:5.1f} MB{cpp_note}{py_note}", flush=True)
 
     with open(os.path.join(outdir, "timescales.csv"), "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
@@ -271,6 +273,7 @@ def render(rows, args, reelay_cpp=False, reelay_cpp_why=None, mismatches=(), cha
         return x == x  # not NaN
 
     over_floor = [r["rvc_ms"] / r["floor_ms"] for r in rows]
+    over_vfloor = [r["rvc_ms"] / r["vfloor_ms"] for r in rows]
     over_decode = [r["rvc_ms"] / r["decode_ms"] for r in rows]
     by = {(r["family"], r["bound"]): r for r in rows}
     b1000_vs_10 = [by[(f, 1000)]["rvc_ms"] / by[(f, 10)]["rvc_ms"] for f in FAMILIES]
@@ -283,8 +286,8 @@ def render(rows, args, reelay_cpp=False, reelay_cpp_why=None, mismatches=(), cha
                    else "each line converted to reelay::json") + " by bench/reelay_cpp/reelay_check.")
     out.append(f"Machine: {machine()}. {args.steps:,} events per file, best of {args.reps} runs, wall clock.{note}\n")
     head = ("| property | rvc check ms | M events/s | peak RSS MB | rvc decode-only ms | simdjson floor ms "
-            "| rvc / floor | rvc / decode-only |")
-    rule = "|---|---:|---:|---:|---:|---:|---:|---:|"
+            "| validating floor ms | rvc / floor | rvc / validating floor | rvc / decode-only |")
+    rule = "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
     if reelay_cpp:
         head += " Reelay C++ ms | Reelay C++ RSS MB | rvc speed-up over Reelay C++ |"
         rule += "---:|---:|---:|"
@@ -294,8 +297,8 @@ def render(rows, args, reelay_cpp=False, reelay_cpp_why=None, mismatches=(), cha
     out += [head, rule]
     for r in rows:
         line = (f"| {r['property']} | {r['rvc_ms']:.1f} | {r['rvc_mev_s']:.2f} | {r['rvc_rss_mb']:.1f} | "
-                f"{r['decode_ms']:.1f} | {r['floor_ms']:.1f} | {r['rvc_ms']/r['floor_ms']:.2f} | "
-                f"{r['rvc_ms']/r['decode_ms']:.2f} |")
+                f"{r['decode_ms']:.1f} | {r['floor_ms']:.1f} | {r['vfloor_ms']:.1f} | {r['rvc_ms']/r['floor_ms']:.2f} | "
+                f"{r['rvc_ms']/r['vfloor_ms']:.2f} | {r['rvc_ms']/r['decode_ms']:.2f} |")
         if reelay_cpp:
             if have(r["reelay_cpp_ms"]):
                 line += (f" {r['reelay_cpp_ms']:.1f} | {r['reelay_cpp_rss_mb']:.1f} | "
@@ -327,6 +330,9 @@ def render(rows, args, reelay_cpp=False, reelay_cpp_why=None, mismatches=(), cha
         out.append(f"- Reelay C++: not measured in this run (fetch/build failed: {reelay_cpp_why.splitlines()[0]})")
     out.append(f"- rvc / simdjson floor (geometric mean): **{geo(over_floor):.2f}** (min {min(over_floor):.2f}, "
                f"max {max(over_floor):.2f})")
+    out.append(f"- rvc / validating floor (every scalar read by type, as a reader that rejects malformed values "
+               f"must; geometric mean): **{geo(over_vfloor):.2f}** (min {min(over_vfloor):.2f}, "
+               f"max {max(over_vfloor):.2f})")
     out.append(f"- rvc / rvc decode-only (monitoring cost alone, geometric mean): **{geo(over_decode):.2f}** "
                f"(min {min(over_decode):.2f}, max {max(over_decode):.2f})")
     out.append(f"- bound 1000 / bound 10, per family: **{', '.join(f'{x:.2f}' for x in b1000_vs_10)}** "
