@@ -112,6 +112,7 @@ SyncedPipeline::SyncedPipeline(const std::vector<engine::PropertySpec>& properti
     if (!seen.insert(i.name).second) throw std::invalid_argument("two inputs are named '" + i.name + "'");
   }
   const bool dense = options.model == engine::TimeModel::Dense;
+  if (options.explain) checker_.enable_explain();  // before the properties, as Pipeline does
   for (const auto& p : properties) {
     try {
       checker_.add_property(p);

@@ -180,6 +180,14 @@ def test_several_topics_of_a_bag_in_one_run(rvc, tmp_path, typestore):
         assert f"gear={GEAR_TOPIC} ({GEAR}, 50)" in got.stderr and "sync merge" in got.stderr, got.stderr
         mon = run([rvc, "monitor", "--all", *mode, "--spec", spec, "--input", f"mcap:{bag}", *topics])
         assert mon.stdout == want.stdout, mon.stderr
+    # --explain across synchronized inputs: the same sentences as for the merged stream as one input
+    # (a spec without message constants reads the same on both).
+    for mode, spec in [([], "historically({steer.steering_tire_angle < 0.3} or {gear.report > 1})"),
+                       (["--dense"], "historically[0:0.2]{steer.steering_tire_angle > -0.4}")]:
+        got = run([rvc, "check", "--explain", *mode, "--spec", spec, bag, *topics])
+        want = run([rvc, "check", "--explain", *mode, "--time-field", "t", "--spec", spec, trace])
+        assert '"explain":[' in want.stdout, want.stdout
+        assert got.stdout == want.stdout, got.stderr
     # A topic named by its last part; an unknown one is named with the bag's topics.
     r = run([rvc, "check", "--spec", "{gear_status.report == 2}", bag, "--topic", GEAR_TOPIC, "--topic", STEER_TOPIC])
     assert r.returncode in (0, 1), r.stderr
