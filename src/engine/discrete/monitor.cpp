@@ -106,7 +106,7 @@ void Monitor::step(const uint8_t* atoms) {
     const uint8_t a = v[op->a] ^ op->negate_a;
     const uint8_t b = v[op->b] ^ op->negate_b;
     const uint8_t last = v[op->out];  // this operator's output at the previous step
-    uint8_t r;
+    uint8_t r = 0;  // every Kind sets it; the compiler cannot tell the switch is exhaustive
     switch (op->kind) {
       case Kind::And: r = a & b; break;
       case Kind::Or: r = a | b; break;
