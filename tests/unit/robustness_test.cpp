@@ -86,6 +86,14 @@ TEST(RobustChecker, BoundedSinceByHand) {
   EXPECT_EQ(run("{x > 3} since[:2] {y > 1}"), (V{-1, 3, 1, 1, 5, 3}));
 }
 
+// A dense-time robustness Checker over one property, recording every change in `out`.
+Checker dense_robust(const std::string& spec, std::vector<std::pair<double, double>>& out) {
+  Checker c(TimeModel::Dense, false, [&out](const Verdict& v) { out.emplace_back(v.time, v.robustness); });
+  c.enable_robustness();
+  c.add_property({"p", spec});
+  return c;
+}
+
 // Dense time: x = 1 on [0, 1), 3 on [1, 2.5), 0 on [2.5, 3), 5 on [3, 6), 2 on [6, 7); the
 // margins of {x > 2} are -1, 1, -2, 3, 0. Windows are closed, pieces right-open; values worked
 // out by hand (and equal to Reelay 25's).
@@ -93,9 +101,7 @@ TEST(RobustDense, WindowsOverPiecesByHand) {
   const std::pair<double, double> pieces[] = {{0, -1}, {1, 1}, {2.5, -2}, {3, 3}, {6, 0}};
   const auto run = [&](const std::string& spec) {
     std::vector<std::pair<double, double>> out;
-    Checker c(TimeModel::Dense, false, [&](const Verdict& v) { out.emplace_back(v.time, v.robustness); });
-    c.enable_robustness();
-    c.add_property({"p", spec});
+    Checker c = dense_robust(spec, out);
     for (size_t i = 0; i < std::size(pieces); ++i) {
       const double margin = pieces[i].second;
       c.step_robust(pieces[i].first, i + 1 < std::size(pieces) ? pieces[i + 1].first : 7.0, &margin);
@@ -127,9 +133,7 @@ TEST(RobustDense, SinceOverPiecesByHand) {
   const Piece pieces[] = {{0, 1, -1}, {1, 2, 3}, {2, -1, 0}, {4, 4, -2}};
   const auto run = [&](const std::string& spec) {
     std::vector<std::pair<double, double>> out;
-    Checker c(TimeModel::Dense, false, [&](const Verdict& v) { out.emplace_back(v.time, v.robustness); });
-    c.enable_robustness();
-    c.add_property({"p", spec});
+    Checker c = dense_robust(spec, out);
     for (size_t i = 0; i < std::size(pieces); ++i) {
       const double margins[] = {pieces[i].x, pieces[i].y};
       c.step_robust(pieces[i].t, i + 1 < std::size(pieces) ? pieces[i + 1].t : 5.0, margins);
