@@ -6,6 +6,7 @@
 #include <cstring>
 
 #include "io/field_tests.hpp"
+#include "io/raw_key.hpp"
 
 namespace rvc::io {
 
@@ -27,15 +28,6 @@ ValueKind kind_of(json_type t) {
 }
 
 const char* type_name(json_type t) { return value_kind_name(kind_of(t)); }
-
-// Length of a raw key: the bytes before its closing quote. A backslash
-// escapes the byte after it, so `\\"` (an escaped backslash, then the quote)
-// ends the key: looking only at the byte before a quote would read past it.
-size_t raw_key_length(const char* k) {
-  size_t n = 0;
-  while (k[n] != '"') n += k[n] == '\\' ? 2 : 1;
-  return n;
-}
 
 bool raw_has_backslash(simdjson::ondemand::raw_json_string raw) {
   const char* k = reinterpret_cast<const char*>(raw.raw());
@@ -216,28 +208,12 @@ __attribute__((always_inline)) inline bool JsonDecoder::fast_path(KeyNode& node,
   if (node.kind == Kind::Bool) {
     bool b;
     if (value.get_bool().get(b)) return false;
-    uint8_t* out = next_.data();
-    for (const BoolTest *t = node.bool_tests.data(), *end = t + node.bool_tests.size(); t != end; ++t)
-      out[t->id] = b ? t->if_true : t->if_false;
+    bool_tests(node, b);
     return true;
   }
   double d;
   if (value.get_double().get(d)) return false;
-  for (int id : node.tests) {
-    const spec::FieldTest& t = atoms_.tests()[id];
-    const double x = t.value.number;
-    uint8_t r = 1;
-    switch (t.op) {
-      case FOp::Eq: r = d == x; break;
-      case FOp::Ne: r = d != x; break;
-      case FOp::Lt: r = d < x; break;
-      case FOp::Le: r = d <= x; break;
-      case FOp::Gt: r = d > x; break;
-      case FOp::Ge: r = d >= x; break;
-      default: break;  // Present
-    }
-    next_[id] = r;
-  }
+  number_tests(node, d);
   return true;
 }
 
@@ -259,7 +235,8 @@ bool JsonDecoder::invalid(std::string& error, simdjson::error_code err, const st
   return false;
 }
 
-bool JsonDecoder::decode(simdjson::ondemand::object object, std::string& error, std::vector<std::string>* warnings) {
+// Every message starts from the committed values: a field it lacks keeps its value.
+void JsonDecoder::begin_message() {
   std::copy(current_.begin(), current_.end(), next_.begin());  // (memcpy of no atoms: null pointers)
   std::copy(bound_.begin(), bound_.end(), next_bound_.begin());
   for (int id : presence_tests_) next_[id] = 0;
@@ -270,6 +247,10 @@ bool JsonDecoder::decode(simdjson::ondemand::object object, std::string& error, 
   saw_time_ = false;
   malformed_ = false;
   ++generation_;
+}
+
+bool JsonDecoder::decode(simdjson::ondemand::object object, std::string& error, std::vector<std::string>* warnings) {
+  begin_message();
   if (!decode_object(object, root_, error, warnings)) return false;
   if (options_.need_time && !saw_time_) {
     error = "missing time field \"" + options_.time_field + "\" (dense time needs one in every message)";
@@ -452,7 +433,13 @@ bool JsonDecoder::apply_tests(KeyNode& node, simdjson::ondemand::value value, js
     malformed_ = true;
     return false;
   }
-  const FieldValue v{kind_of(type), b, d, s};
+  return apply_value(node, FieldValue{kind_of(type), b, d, s}, error, warnings);
+}
+
+// A scalar's tests, whatever its type (a type a test cannot use leaves that
+// test's value as it was, with a warning; in strict mode it rejects the message).
+bool JsonDecoder::apply_value(KeyNode& node, const FieldValue& v, std::string& error,
+                              std::vector<std::string>* warnings) {
   for (int id : node.tests) {
     const spec::FieldTest& t = atoms_.tests()[id];
     const int result = evaluate_test(t, v);  // -1: wrong type, the test keeps its previous value
@@ -462,7 +449,7 @@ bool JsonDecoder::apply_tests(KeyNode& node, simdjson::ondemand::value value, js
       if (t.op == FOp::Bind) next_bound_[id] = bound_ids_.id(v);
       continue;
     }
-    if (type == json_type::null && !options_.strict) continue;  // null: no value, like a missing field
+    if (v.kind == ValueKind::Null && !options_.strict) continue;  // null: no value, like a missing field
     std::string problem = wrong_type_problem(t, v.kind);
     if (options_.strict) {
       error = problem;

@@ -17,6 +17,7 @@
 
 #include "engine/atom_table.hpp"
 #include "io/bound_values.hpp"
+#include "io/json_layout.hpp"
 
 namespace rvc::io {
 
@@ -25,6 +26,9 @@ struct DecoderOptions {
   std::string time_field = "time";
   bool strict = false;
   bool robustness = false;  // also each test's margin (--robustness; general path only)
+  // Read lines laid out like earlier ones by position (JsonLayout) instead of
+  // parsing them. Off only to compare the two paths (tests, fuzzing).
+  bool layouts = true;
 };
 
 class JsonDecoder {
@@ -35,6 +39,20 @@ class JsonDecoder {
   // must be rejected, leaving the committed values untouched. Warnings about
   // fields that kept their previous value are appended to `warnings`.
   bool decode(simdjson::ondemand::object object, std::string& error, std::vector<std::string>* warnings = nullptr);
+  // The layout fast path (JsonLayout). match() says whether `line` (one
+  // message's text) has a layout learned from an earlier message, reading its
+  // values; decode_matched() then decodes that line as decode() would have.
+  // A line that does not match goes to decode() (and simdjson) as usual.
+  bool match(std::string_view line);
+  bool decode_matched(std::string& error, std::vector<std::string>* warnings = nullptr);
+  // After a message read by decode() was accepted: whether its layout should
+  // be learned now (attempts back off while learned layouts go unused), and
+  // learning it from the message's text.
+  bool learns_layouts() const { return options_.layouts && !options_.strict; }
+  bool wants_layout() { return learns_layouts() && ++slow_since_learn_ >= learn_interval_; }
+  void learn(std::string_view line);
+  size_t layouts() const { return layouts_.size(); }
+
   // After decode() returned false: whether the JSON itself was malformed
   // (rather than valid JSON that the properties cannot use).
   bool malformed() const { return malformed_; }
@@ -90,6 +108,21 @@ class JsonDecoder {
     bool is_index = false;           // an array element: name "[N]"
     std::vector<KeyNode*> by_index;  // the element children by index (null: not tested)
   };
+  // A layout with the field each of its slots feeds (null: only checked).
+  struct LearnedLayout {
+    JsonLayout layout;
+    std::vector<KeyNode*> targets;
+    int time_slot = -1;  // the slot holding the time (dense), which must be a number
+    uint64_t last_used = 0;
+  };
+  struct LayoutWalk;
+  bool learn_object(simdjson::ondemand::object object, KeyNode* node, LayoutWalk& walk, int depth);
+  bool learn_value(simdjson::ondemand::value value, KeyNode* node, LayoutWalk& walk, int depth);
+  void begin_message();
+  void bool_tests(const KeyNode& node, bool b);
+  void number_tests(const KeyNode& node, double d);
+  bool apply_matched(KeyNode& target, const FieldValue& value, std::string& error, std::vector<std::string>* warnings);
+  bool apply_value(KeyNode& node, const FieldValue& value, std::string& error, std::vector<std::string>* warnings);
   void prepare(KeyNode& node);
   static void remember(KeyNode& node, size_t position, simdjson::ondemand::raw_json_string raw, KeyNode* target);
   bool fast_path(KeyNode& node, simdjson::ondemand::value& value);
@@ -119,6 +152,41 @@ class JsonDecoder {
   bool saw_sec_ = false;
   bool malformed_ = false;
   uint32_t generation_ = 0;
+  std::vector<LearnedLayout> layouts_;  // at most kMaxLayouts, replaced least recently used first
+  size_t matched_ = 0;                  // the layout the last match() found
+  uint64_t uses_ = 0;
+  std::vector<FieldValue> slot_values_;  // of the matched line
+  uint32_t slow_since_learn_ = 0, learn_interval_ = 1;
+  simdjson::ondemand::parser learn_parser_;
+  std::string learn_scratch_;
 };
+
+// A Boolean-only field's tests, given its value. (Inline: both the simdjson
+// path and the layout path run these per field.)
+inline void JsonDecoder::bool_tests(const KeyNode& node, bool b) {
+  uint8_t* out = next_.data();
+  for (const BoolTest *t = node.bool_tests.data(), *end = t + node.bool_tests.size(); t != end; ++t)
+    out[t->id] = b ? t->if_true : t->if_false;
+}
+
+// A number-only field's tests, given its value.
+inline void JsonDecoder::number_tests(const KeyNode& node, double d) {
+  for (int id : node.tests) {
+    const spec::FieldTest& t = atoms_.tests()[id];
+    const double x = t.value.number;
+    uint8_t r = 1;
+    using Op = spec::FieldTest::Op;
+    switch (t.op) {
+      case Op::Eq: r = d == x; break;
+      case Op::Ne: r = d != x; break;
+      case Op::Lt: r = d < x; break;
+      case Op::Le: r = d <= x; break;
+      case Op::Gt: r = d > x; break;
+      case Op::Ge: r = d >= x; break;
+      default: break;  // Present
+    }
+    next_[id] = r;
+  }
+}
 
 }  // namespace rvc::io

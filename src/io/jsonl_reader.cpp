@@ -49,6 +49,56 @@ class ChunkProcessor {
   // buf[0, len) holds complete lines (the last ends with '\n' unless at EOF);
   // buf has SIMDJSON_PADDING readable bytes after len.
   void process(const char* buf, size_t len, uint64_t first_line) {
+    if (!handler_.reads_layouts()) return process_stream(buf, len, first_line);
+    // Lines the handler reads by layout are read here; each run of other
+    // lines goes to simdjson's document stream before the next matched line,
+    // so messages keep their order.
+    size_t run = 0;  // the first line not read yet
+    uint64_t run_line = first_line;
+    size_t run_lines = 0;
+    uint64_t line = first_line;
+    for (size_t pos = 0; pos < len; ++line) {
+      const char* nl = static_cast<const char*>(std::memchr(buf + pos, '\n', len - pos));
+      const size_t end = nl ? static_cast<size_t>(nl - buf) : len;
+      std::string_view text(buf + pos, end - pos);
+      const bool fits = text.size() <= max_line_;  // (longer lines: the run's reader reports them)
+      if (!text.empty() && text.back() == '\r') text.remove_suffix(1);  // as Position::text() shows a line
+      if (fits && handler_.match_line(text)) {
+        bool matched = true;
+        if (run < pos) {  // the run before it may teach the handler layouts: match again after it
+          process_stream(buf + run, pos - run, run_line);
+          matched = handler_.match_line(text);
+        }
+        if (matched) {
+          handler_.read_matched(Position(line, text));
+          run = end + 1;
+          run_line = line + 1;
+          run_lines = 0;
+          run_limit_ = 1;
+          pos = end + 1;
+          continue;
+        }
+        run = pos;
+        run_line = line;
+        run_lines = 0;
+      }
+      // Lines the handler cannot match yet: read them with simdjson soon, so
+      // it learns their layout, but in runs that grow while nothing matches
+      // (each run costs a document stream's set-up).
+      if (++run_lines >= run_limit_) {
+        process_stream(buf + run, end + (end < len) - run, run_line);
+        run = end + 1;
+        run_line = line + 1;
+        run_lines = 0;
+        run_limit_ = std::min<size_t>(run_limit_ * 2, 1 << 16);
+      }
+      pos = end + 1;
+    }
+    if (run < len) process_stream(buf + run, len - run, run_line);
+  }
+
+ private:
+  void process_stream(const char* buf, size_t len, uint64_t first_line) {
     if (len == 0) return;
     size_t fast_len = len;  // the fast path reads buf[0, fast_len)
     // With a message-size limit below the chunk size, a long line may sit
@@ -65,7 +115,6 @@ class ChunkProcessor {
       }
     }
     size_t resume = fast_len;  // where line-by-line mode starts
-    bool skip_resume_line = false;  // the line at `resume` held an object with junk after it
     simdjson::ondemand::document_stream stream;
     if (fast_len > 0) {
       if (stream_parser_.iterate_many(buf, fast_len, std::max<size_t>(fast_len, 1 << 16)).get(stream)) {
@@ -88,7 +137,6 @@ class ChunkProcessor {
             if (l != Layout::OwnLine) {
               handler_.discard();
               resume = pending_at;
-              skip_resume_line = l == Layout::SharesLine;
               break;
             }
             handler_.commit();
@@ -120,7 +168,6 @@ class ChunkProcessor {
           } else {
             handler_.discard();
             resume = pending_at;
-            skip_resume_line = l == Layout::SharesLine;
           }
         } else if (resume == fast_len && stream.truncated_bytes() > 0) {
           resume = fast_len - stream.truncated_bytes();
@@ -132,14 +179,6 @@ class ChunkProcessor {
     while (resume > 0 && buf[resume - 1] != '\n') --resume;
     uint64_t line = first_line + count_newlines(buf, buf + resume);
     size_t pos = resume;
-    if (skip_resume_line) {
-      // An object followed by more text on its line ({"p":true}} or two
-      // objects on one line): the line is one bad message.
-      handler_.on_error(LineError{line, 0, "unexpected text after the JSON object"});
-      const char* nl = static_cast<const char*>(std::memchr(buf + pos, '\n', len - pos));
-      pos = nl ? static_cast<size_t>(nl - buf) + 1 : len;
-      ++line;
-    }
     while (pos < len) {
       const char* nl = static_cast<const char*>(std::memchr(buf + pos, '\n', len - pos));
       size_t end = nl ? static_cast<size_t>(nl - buf) : len;
@@ -158,9 +197,9 @@ class ChunkProcessor {
     }
   }
 
- private:
   JsonlHandler& handler_;
   size_t max_line_;
+  size_t run_limit_ = 1;  // lines the next run of unmatched lines may hold (process())
   const char* cache_at_ = nullptr;
   uint64_t cache_line_ = 0;
   simdjson::ondemand::parser stream_parser_, line_parser_;
@@ -258,10 +297,23 @@ void parse_one(simdjson::ondemand::parser& parser, std::string_view text, uint64
     return;
   }
   if (r == ReadResult::Rejected) return;
-  // The handler iterated the whole object (skipping what it does not read),
-  // so anything left is text after the object.
+  // Anything left is text after the object, unless the handler stopped
+  // early, at a field it refuses (a time that is not a number): then the
+  // rest of the object is skipped first, so that the error is that refusal,
+  // as when the line is read in a document stream.
   // current_location() succeeds only while text remains (simdjson 3.0 has no at_end()).
   const char* rest = nullptr;
+  if (!doc.current_location().get(rest)) {
+    doc.rewind();
+    simdjson::ondemand::object whole;
+    simdjson::error_code err = doc.get_object().get(whole);
+    for (auto field = whole.begin(); !err && field != whole.end(); ++field) err = (*field).error();
+    if (err) {
+      handler.discard();
+      fail("invalid JSON", err);
+      return;
+    }
+  }
   if (!doc.current_location().get(rest)) {
     handler.discard();
     uint64_t column = 0;

@@ -75,6 +75,15 @@ class JsonlHandler {
   virtual void on_warning(const LineError& warning) {}
   // The JSON error behind the last `false` from on_object.
   virtual std::string json_error() const { return "invalid JSON"; }
+
+  // The layout fast path (io/json_layout.hpp). A handler that reads layouts
+  // is offered each line first: match_line() says whether the line has a
+  // layout it learned from earlier messages (acting on nothing yet); if so,
+  // read_matched() reads and commits that line, and simdjson never sees it.
+  // Lines that do not match go through on_object() as before, in order.
+  virtual bool reads_layouts() const { return false; }
+  virtual bool match_line(std::string_view) { return false; }
+  virtual void read_matched(const Position&) {}
 };
 
 struct ReaderOptions {

@@ -71,6 +71,7 @@ std::string MonitorLoop::stats_json() const {
       .add("checked", p.accepted)
       .add("rejected", p.rejected)
       .add("warnings", p.warnings)
+      .add("by_layout", p.by_layout)
       .add("gaps", total(&transport::SeqCounters::gaps))
       .add("duplicates", total(&transport::SeqCounters::duplicates))
       .add("last_seq", total(&transport::SeqCounters::last_seq))

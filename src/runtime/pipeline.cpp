@@ -53,7 +53,7 @@ Pipeline::Pipeline(const std::vector<engine::PropertySpec>& properties, const Pi
       options_(with_defaults(options)),
       atoms_(checker_.atoms()),
       decoder_(atoms_, io::DecoderOptions{options.model == engine::TimeModel::Dense, options.time_field,
-                                          options.strict, options.robustness}),
+                                          options.strict, options.robustness, options.layouts}),
       batch_reader_(*this, options.max_message_size) {
   make_typed_decoder();
   // --explain names the values a data reference decided on by their JSON
@@ -78,7 +78,7 @@ Pipeline::Pipeline(const engine::AtomTable& atoms, const PipelineOptions& option
       atoms_(atoms),
       hook_(std::move(hook)),
       decoder_(atoms_, io::DecoderOptions{options.model == engine::TimeModel::Dense, options.time_field,
-                                          options.strict}),
+                                          options.strict, false, options.layouts}),
       batch_reader_(*this, options.max_message_size) {
   make_typed_decoder();
 }
@@ -115,9 +115,21 @@ io::ReadResult Pipeline::on_object(const io::Position& where, simdjson::ondemand
     pending_rejection_ = error;
   }
   pending_ = true;
+  pending_matched_ = false;
   pending_where_.emplace(where);
   if (options_.on_message) pending_text_ = where.text();
   return io::ReadResult::Pending;
+}
+
+void Pipeline::read_matched(const io::Position& where) {
+  std::string error;
+  warnings_.clear();
+  if (!decoder_.decode_matched(error, &warnings_)) pending_rejection_ = error;
+  pending_ = true;
+  pending_matched_ = true;
+  pending_where_.emplace(where);
+  if (options_.on_message) pending_text_ = where.text();
+  commit();  // the layout covered the whole line: nothing can follow it
 }
 
 // A data reference past --max-data-values stops the run: the error names
@@ -181,6 +193,9 @@ void Pipeline::commit() {
     last_time_ = t;
   }
   ++stats_.accepted;
+  stats_.by_layout += pending_matched_;
+  // A message simdjson read teaches its layout, so the next ones like it are read by position.
+  if (!pending_matched_ && !typed_ && decoder_.wants_layout()) decoder_.learn(pending_where_->text());
 }
 
 bool Pipeline::oversized(std::string_view payload, uint64_t position) {
@@ -205,6 +220,7 @@ void Pipeline::feed(std::string_view payload, uint64_t position) {
     return;
   }
   if (oversized(payload, position)) return;
+  if (decoder_.match(payload)) return read_matched(io::Position(position, payload));
   io::parse_one(parser_, payload, position, *this, scratch_);
 }
 

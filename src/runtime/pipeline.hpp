@@ -34,6 +34,7 @@ struct PipelineOptions {
   bool explain = false;                // a violation's verdict says why (discrete)
   uint32_t max_data_values = 100000;   // data references: distinct values per variable
   size_t max_message_size = 1 << 20;   // longest message: a line, a payload, a line inside a batched payload
+  bool layouts = true;                 // read lines laid out like earlier ones by position (io/json_layout.hpp)
   // Typed input (--type): each payload is one CDR sample of this type,
   // decoded straight into the tests' values (properties are checked against
   // the type first). Owned by the caller's msg::TypeRegistry; null: JSON.
@@ -69,6 +70,9 @@ class Pipeline final : public io::JsonlHandler, public Feed {
     pending_ = false;
     pending_rejection_.clear();
   }
+  bool reads_layouts() const override { return !typed_ && decoder_.learns_layouts(); }
+  bool match_line(std::string_view text) override { return decoder_.match(text); }
+  void read_matched(const io::Position& where) override;
   void on_error(const io::LineError& error) override;
   void on_warning(const io::LineError& warning) override;
   // One network payload; `position` names it in errors (its sequence number).
@@ -108,6 +112,7 @@ class Pipeline final : public io::JsonlHandler, public Feed {
   PipelineStats stats_;
   bool has_time_ = false;
   bool pending_ = false;        // decoded, waiting for commit()
+  bool pending_matched_ = false;  // ... read by its layout (else by simdjson, and its layout may be learned)
   // Where the pending message came from. A copy, not a pointer: the reader's
   // Position may be a temporary that is gone by commit().
   std::optional<io::Position> pending_where_;
