@@ -39,11 +39,13 @@ class JsonDecoder {
   // must be rejected, leaving the committed values untouched. Warnings about
   // fields that kept their previous value are appended to `warnings`.
   bool decode(simdjson::ondemand::object object, std::string& error, std::vector<std::string>* warnings = nullptr);
-  // The layout fast path (JsonLayout). match() says whether `line` (one
-  // message's text) has a layout learned from an earlier message, reading its
-  // values; decode_matched() then decodes that line as decode() would have.
-  // A line that does not match goes to decode() (and simdjson) as usual.
-  bool match(std::string_view line);
+  // The layout fast path (JsonLayout). match() says whether `text` (one
+  // message) has a layout learned from an earlier message, reading its
+  // values; decode_matched() then decodes it as decode() would have. A
+  // message that does not match goes to decode() (and simdjson) as usual.
+  bool match(std::string_view text);
+  // The same for the line starting at p: its end (its newline, or `end`), or null.
+  const char* match_line(const char* p, const char* end);
   bool decode_matched(std::string& error, std::vector<std::string>* warnings = nullptr);
   // After a message read by decode() was accepted: whether its layout should
   // be learned now (attempts back off while learned layouts go unused), and
@@ -108,10 +110,17 @@ class JsonDecoder {
     bool is_index = false;           // an array element: name "[N]"
     std::vector<KeyNode*> by_index;  // the element children by index (null: not tested)
   };
-  // A layout with the field each of its slots feeds (null: only checked).
+  // A layout with the fields its slots feed (the other slots are only checked).
+  struct SlotUse {
+    // Bool, Number: Kind's fast paths; OneBool: a field with a single Boolean test, `test`.
+    enum How : uint8_t { OneBool, Bool, Number, General, Time } how;
+    uint32_t slot;
+    KeyNode* target;
+    BoolTest test;
+  };
   struct LearnedLayout {
     JsonLayout layout;
-    std::vector<KeyNode*> targets;
+    std::vector<SlotUse> uses;
     int time_slot = -1;  // the slot holding the time (dense), which must be a number
     uint64_t last_used = 0;
   };
@@ -121,7 +130,6 @@ class JsonDecoder {
   void begin_message();
   void bool_tests(const KeyNode& node, bool b);
   void number_tests(const KeyNode& node, double d);
-  bool apply_matched(KeyNode& target, const FieldValue& value, std::string& error, std::vector<std::string>* warnings);
   bool apply_value(KeyNode& node, const FieldValue& value, std::string& error, std::vector<std::string>* warnings);
   void prepare(KeyNode& node);
   static void remember(KeyNode& node, size_t position, simdjson::ondemand::raw_json_string raw, KeyNode* target);

@@ -114,11 +114,24 @@ void JsonDecoder::learn(std::string_view line) {
   walk.base = learn_scratch_.data();
   if (!learn_object(object, &root_, walk, 0)) return;
   if (options_.need_time && walk.time_slot < 0) return;
-  LearnedLayout learned{JsonLayout(text, walk.values, walk.convert), std::move(walk.targets), walk.time_slot, ++uses_};
-  if (slot_values_.size() < learned.targets.size()) slot_values_.resize(learned.targets.size());
+  LearnedLayout learned{JsonLayout(text, walk.values, walk.convert), {}, walk.time_slot, ++uses_};
+  for (size_t i = 0; i < walk.targets.size(); ++i) {
+    KeyNode* t = walk.targets[i];
+    if (!t) continue;
+    const bool fast = !options_.robustness && !t->time_part;
+    const auto how = t->time_part ? SlotUse::Time
+                     : fast && t->kind == Kind::Bool   ? SlotUse::Bool
+                     : fast && t->kind == Kind::Number ? SlotUse::Number
+                                                       : SlotUse::General;
+    SlotUse use{how, static_cast<uint32_t>(i), t, {}};
+    if (how == SlotUse::Bool && t->bool_tests.size() == 1) use.how = SlotUse::OneBool, use.test = t->bool_tests[0];
+    learned.uses.push_back(use);
+  }
+  if (slot_values_.size() < walk.targets.size()) slot_values_.resize(walk.targets.size());
   if (layouts_.size() < kMaxLayouts) {
     layouts_.push_back(std::move(learned));
   } else {
+    layouts_[matched_].last_used = ++uses_;  // the layout in use stays
     auto oldest = std::min_element(layouts_.begin(), layouts_.end(), [](const LearnedLayout& a, const LearnedLayout& b) {
       return a.last_used < b.last_used;
     });
@@ -126,52 +139,63 @@ void JsonDecoder::learn(std::string_view line) {
   }
 }
 
-bool JsonDecoder::match(std::string_view line) {
-  if (layouts_.empty()) return false;
-  const std::string_view text = layout_text(line);
+const char* JsonDecoder::match_line(const char* p, const char* end) {
+  if (layouts_.empty()) return nullptr;
+  while (p != end && (*p == ' ' || *p == '\t' || *p == '\r')) ++p;
   // The layout that matched last is the likeliest: try it first.
-  for (size_t k = 0; k < layouts_.size(); ++k) {
-    const size_t i = (matched_ + k) % layouts_.size();
+  for (size_t k = 0, n = layouts_.size(), i = matched_; k < n; ++k, i = i + 1 == n ? 0 : i + 1) {
     LearnedLayout& l = layouts_[i];
-    if (!l.layout.match(text, slot_values_.data())) continue;
+    const char* stop = l.layout.match(p, end, slot_values_.data());
+    if (!stop) continue;
+    while (stop != end && (*stop == ' ' || *stop == '\t' || *stop == '\r')) ++stop;
+    if (stop != end && *stop != '\n') continue;  // more text on the line
     // A time that is not a number: decode() words that error.
-    if (l.time_slot >= 0 && slot_values_[l.time_slot].kind != ValueKind::Number) return false;
-    matched_ = i;
-    l.last_used = ++uses_;
+    if (l.time_slot >= 0 && slot_values_[l.time_slot].kind != ValueKind::Number) return nullptr;
+    if (i != matched_) {
+      matched_ = i;
+      l.last_used = ++uses_;
+    }
     learn_interval_ = 1;
-    return true;
+    return stop;
   }
-  return false;
+  return nullptr;
 }
 
-// One matched value of a tested field (or the time), as decode_value() reads a scalar.
-inline bool JsonDecoder::apply_matched(KeyNode& target, const FieldValue& v, std::string& error,
-                                       std::vector<std::string>* warnings) {
-  if (target.time_part == 1) {
-    saw_time_ = true;
-    next_time_ = v.d;
-  }
-  if (target.tests.empty()) return true;
-  if (!options_.robustness) {
-    if (target.kind == Kind::Bool && v.kind == ValueKind::Bool) {
-      bool_tests(target, v.b);
-      return true;
-    }
-    if (target.kind == Kind::Number && v.kind == ValueKind::Number) {
-      number_tests(target, v.d);
-      return true;
-    }
-  }
-  return apply_value(target, v, error, warnings);
+bool JsonDecoder::match(std::string_view text) {
+  const char* end = text.data() + text.size();
+  return match_line(text.data(), end) == end;
 }
 
 bool JsonDecoder::decode_matched(std::string& error, std::vector<std::string>* warnings) {
   begin_message();
   const LearnedLayout& l = layouts_[matched_];
-  const FieldValue* v = slot_values_.data();
-  for (KeyNode* target : l.targets) {
-    if (target && !apply_matched(*target, *v, error, warnings)) return false;
-    ++v;
+  const FieldValue* values = slot_values_.data();
+  // As decode_value() reads a scalar: the fast paths when the value has the
+  // type the field's tests expect, the general path otherwise.
+  for (const SlotUse& use : l.uses) {
+    const FieldValue& v = values[use.slot];
+    KeyNode& target = *use.target;
+    switch (use.how) {
+      case SlotUse::OneBool:
+        if (v.kind != ValueKind::Bool) break;
+        next_[use.test.id] = v.b ? use.test.if_true : use.test.if_false;
+        continue;
+      case SlotUse::Bool:
+        if (v.kind != ValueKind::Bool) break;
+        bool_tests(target, v.b);
+        continue;
+      case SlotUse::Number:
+        if (v.kind != ValueKind::Number) break;
+        number_tests(target, v.d);
+        continue;
+      case SlotUse::Time:  // a number (match() made sure)
+        saw_time_ = true;
+        next_time_ = v.d;
+        if (target.tests.empty()) continue;
+        break;
+      case SlotUse::General: break;
+    }
+    if (!apply_value(target, v, error, warnings)) return false;
   }
   time_ = next_time_;  // a layout of a dense stream always has its time slot
   return true;

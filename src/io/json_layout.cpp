@@ -8,8 +8,6 @@
 namespace rvc::io {
 namespace {
 
-bool json_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; }
-
 // a[0, n) == b[0, n), for the short runs between values (a key and its
 // punctuation): overlapping word loads instead of a call to memcmp. Every
 // load stays inside both ranges, so a payload without padding is safe.
@@ -32,6 +30,12 @@ inline bool same_bytes(const char* a, const char* b, size_t n) {
   return true;
 }
 
+inline uint32_t word4(const char* p) {
+  uint32_t w;
+  std::memcpy(&w, p, 4);
+  return w;
+}
+
 inline bool digit(char c) { return static_cast<unsigned char>(c - '0') < 10; }
 
 // Powers of ten a double holds exactly.
@@ -52,13 +56,24 @@ const char* scan_number(const char* p, const char* end, bool convert, double& ou
   if (*q == '0') {
     ++q;
   } else if (digit(*q)) {
-    for (; q != end && digit(*q); ++q, ++digits) mantissa = mantissa * 10 + static_cast<unsigned>(*q - '0');
+    const char* first = q;
+    if (convert)
+      for (; q != end && digit(*q); ++q) mantissa = mantissa * 10 + static_cast<unsigned>(*q - '0');
+    else
+      while (q != end && digit(*q)) ++q;
+    digits = static_cast<int>(q - first);
   } else {
     return nullptr;
   }
   if (q != end && *q == '.') {
     if (++q == end || !digit(*q)) return nullptr;
-    for (; q != end && digit(*q); ++q, ++digits, ++fraction) mantissa = mantissa * 10 + static_cast<unsigned>(*q - '0');
+    const char* first = q;
+    if (convert)
+      for (; q != end && digit(*q); ++q) mantissa = mantissa * 10 + static_cast<unsigned>(*q - '0');
+    else
+      while (q != end && digit(*q)) ++q;
+    fraction = static_cast<int>(q - first);
+    digits += fraction;
   }
   bool exponent = false;
   if (q != end && (*q == 'e' || *q == 'E')) {
@@ -94,15 +109,15 @@ inline const char* scan_scalar(const char* p, const char* end, bool convert, Fie
   if (p == end) return nullptr;
   switch (*p) {
     case 't':
-      if (end - p < 4 || std::memcmp(p, "true", 4) != 0) return nullptr;
+      if (end - p < 4 || word4(p) != word4("true")) return nullptr;
       v.kind = ValueKind::Bool, v.b = true;
       return p + 4;
     case 'f':
-      if (end - p < 5 || std::memcmp(p, "false", 5) != 0) return nullptr;
+      if (end - p < 5 || word4(p + 1) != word4("alse")) return nullptr;
       v.kind = ValueKind::Bool, v.b = false;
       return p + 5;
     case 'n':
-      if (end - p < 4 || std::memcmp(p, "null", 4) != 0) return nullptr;
+      if (end - p < 4 || word4(p) != word4("null")) return nullptr;
       v.kind = ValueKind::Null;
       return p + 4;
     case '"': {
@@ -128,17 +143,17 @@ inline const char* scan_scalar(const char* p, const char* end, bool convert, Fie
 
 }  // namespace
 
-std::string_view layout_text(std::string_view line) {
-  while (!line.empty() && json_space(line.front())) line.remove_prefix(1);
-  while (!line.empty() && json_space(line.back())) line.remove_suffix(1);
-  return line;
-}
-
 JsonLayout::JsonLayout(std::string_view text, const std::vector<Range>& values, const std::vector<bool>& convert) {
   size_t at = 0;
   for (size_t i = 0; i < values.size(); ++i) {
     const Range& r = values[i];
-    slots_.push_back(Slot{static_cast<uint32_t>(skeleton_.size()), static_cast<uint32_t>(r.begin - at), convert[i]});
+    Slot slot{static_cast<uint32_t>(skeleton_.size()), static_cast<uint32_t>(r.begin - at)};
+    slot.convert = convert[i];
+    if (slot.before_len <= 8) {
+      std::memcpy(&slot.word, text.data() + at, slot.before_len);
+      slot.mask = slot.before_len == 8 ? ~uint64_t{0} : (uint64_t{1} << (8 * slot.before_len)) - 1;
+    }
+    slots_.push_back(slot);
     skeleton_.append(text.substr(at, r.begin - at));
     at = r.end;
   }
@@ -147,17 +162,22 @@ JsonLayout::JsonLayout(std::string_view text, const std::vector<Range>& values, 
   skeleton_.append(text.substr(at));
 }
 
-bool JsonLayout::match(std::string_view text, FieldValue* out) const {
-  const char* p = text.data();
-  const char* const end = p + text.size();
+const char* JsonLayout::match(const char* p, const char* const end, FieldValue* out) const {
   const char* skeleton = skeleton_.data();
   for (const Slot& slot : slots_) {
-    if (static_cast<size_t>(end - p) < slot.before_len || !same_bytes(p, skeleton + slot.before_at, slot.before_len))
-      return false;
+    if (slot.mask && end - p >= 8) {  // the usual case: a short run, and room for a whole word
+      uint64_t w;
+      std::memcpy(&w, p, 8);
+      if ((w & slot.mask) != slot.word) return nullptr;
+    } else if (static_cast<size_t>(end - p) < slot.before_len ||
+               !same_bytes(p, skeleton + slot.before_at, slot.before_len)) {
+      return nullptr;
+    }
     p += slot.before_len;
-    if (!(p = scan_scalar(p, end, slot.convert, *out++))) return false;
+    if (!(p = scan_scalar(p, end, slot.convert, *out++))) return nullptr;
   }
-  return static_cast<size_t>(end - p) == tail_len_ && same_bytes(p, skeleton + tail_at_, tail_len_);
+  if (static_cast<size_t>(end - p) < tail_len_ || !same_bytes(p, skeleton + tail_at_, tail_len_)) return nullptr;
+  return p + tail_len_;
 }
 
 }  // namespace rvc::io

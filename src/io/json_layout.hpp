@@ -37,13 +37,19 @@ class JsonLayout {
   JsonLayout(std::string_view text, const std::vector<Range>& values, const std::vector<bool>& convert);
 
   size_t slots() const { return slots_.size(); }
-  // Whether `text` has this layout; if so, out[i] holds slot i's value
-  // (strings point into `text`). `out` has slots() entries.
-  bool match(std::string_view text, FieldValue* out) const;
+  // Whether the text at [p, end) starts with a message of this layout: its
+  // end if so (out[i] then holds slot i's value, strings pointing into the
+  // text), else null. `out` has slots() entries. What follows the message is
+  // the caller's to check: a reader finds the end of a line this way, with
+  // no separate search for the newline.
+  const char* match(const char* p, const char* end, FieldValue* out) const;
 
  private:
   struct Slot {
     uint32_t before_at, before_len;  // the skeleton bytes before this value
+    // The same bytes as one little-endian word and the mask of its bytes,
+    // when they fit in 8 (a key and its punctuation, mostly): one compare.
+    uint64_t word = 0, mask = 0;
     bool convert;
   };
   std::string skeleton_;
@@ -54,6 +60,11 @@ class JsonLayout {
 // The text of a line as layouts see it: without the JSON whitespace around
 // it (a CR before the newline, indentation), so a CRLF file, and the same
 // line read as a file or a payload, give one layout.
-std::string_view layout_text(std::string_view line);
+inline std::string_view layout_text(std::string_view line) {
+  const auto space = [](char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; };
+  while (!line.empty() && space(line.front())) line.remove_prefix(1);
+  while (!line.empty() && space(line.back())) line.remove_suffix(1);
+  return line;
+}
 
 }  // namespace rvc::io

@@ -42,14 +42,27 @@ Layout layout(const char* buf, size_t from, size_t to) {
   return Layout::OwnLine;
 }
 
+// A line as Position::text() shows it: from its first non-blank byte, without a final CR.
+std::string_view line_text(const char* begin, const char* end) {
+  while (begin < end && (*begin == ' ' || *begin == '\t' || *begin == '\r')) ++begin;
+  if (end > begin && end[-1] == '\r') --end;
+  return std::string_view(begin, static_cast<size_t>(end - begin));
+}
+
 class ChunkProcessor {
  public:
   ChunkProcessor(JsonlHandler& handler, size_t max_line) : handler_(handler), max_line_(max_line) {}
 
   // buf[0, len) holds complete lines (the last ends with '\n' unless at EOF);
-  // buf has SIMDJSON_PADDING readable bytes after len.
-  void process(const char* buf, size_t len, uint64_t first_line) {
-    if (!handler_.reads_layouts()) return process_stream(buf, len, first_line);
+  // buf has SIMDJSON_PADDING readable bytes after len. Returns the number of
+  // lines if it counted them (reading layouts, it walks every line), else
+  // kUncounted.
+  static constexpr uint64_t kUncounted = ~uint64_t{0};
+  uint64_t process(const char* buf, size_t len, uint64_t first_line) {
+    if (!handler_.reads_layouts()) {
+      process_stream(buf, len, first_line);
+      return kUncounted;
+    }
     // Lines the handler reads by layout are read here; each run of other
     // lines goes to simdjson's document stream before the next matched line,
     // so messages keep their order.
@@ -58,19 +71,17 @@ class ChunkProcessor {
     size_t run_lines = 0;
     uint64_t line = first_line;
     for (size_t pos = 0; pos < len; ++line) {
-      const char* nl = static_cast<const char*>(std::memchr(buf + pos, '\n', len - pos));
+      // A matched line's end is where its layout ends: no search for the newline.
+      const char* matched = handler_.match_line(buf + pos, buf + len);
+      const char* nl = matched ? matched : static_cast<const char*>(std::memchr(buf + pos, '\n', len - pos));
       const size_t end = nl ? static_cast<size_t>(nl - buf) : len;
-      std::string_view text(buf + pos, end - pos);
-      const bool fits = text.size() <= max_line_;  // (longer lines: the run's reader reports them)
-      if (!text.empty() && text.back() == '\r') text.remove_suffix(1);  // as Position::text() shows a line
-      if (fits && handler_.match_line(text)) {
-        bool matched = true;
+      if (matched && end - pos <= max_line_) {  // (longer lines: the run's reader reports them)
         if (run < pos) {  // the run before it may teach the handler layouts: match again after it
           process_stream(buf + run, pos - run, run_line);
-          matched = handler_.match_line(text);
+          matched = handler_.match_line(buf + pos, buf + len);
         }
         if (matched) {
-          handler_.read_matched(Position(line, text));
+          handler_.read_matched(Position(line, line_text(buf + pos, buf + end)));
           run = end + 1;
           run_line = line + 1;
           run_lines = 0;
@@ -95,6 +106,7 @@ class ChunkProcessor {
       pos = end + 1;
     }
     if (run < len) process_stream(buf + run, len - run, run_line);
+    return line - first_line;
   }
 
  private:
@@ -377,9 +389,9 @@ bool read_jsonl(int fd, JsonlHandler& handler, const ReaderOptions& options, std
         if (buf[i - 1] == '\n') { complete = i; break; }
     }
     if (complete > 0) {
-      processor.process(buf.data(), complete, line);
+      const uint64_t lines = processor.process(buf.data(), complete, line);
       if (options.after_chunk) options.after_chunk();
-      line += static_cast<uint64_t>(count_newlines(buf.data(), buf.data() + complete));
+      line += lines != ChunkProcessor::kUncounted ? lines : count_newlines(buf.data(), buf.data() + complete);
       std::memmove(buf.data(), buf.data() + complete, have - complete);
       have -= complete;
     }

@@ -77,12 +77,14 @@ class JsonlHandler {
   virtual std::string json_error() const { return "invalid JSON"; }
 
   // The layout fast path (io/json_layout.hpp). A handler that reads layouts
-  // is offered each line first: match_line() says whether the line has a
-  // layout it learned from earlier messages (acting on nothing yet); if so,
-  // read_matched() reads and commits that line, and simdjson never sees it.
-  // Lines that do not match go through on_object() as before, in order.
+  // is offered each line first: match_line() says whether the text at
+  // [p, end) starts with a line that has a layout it learned from earlier
+  // messages, returning that line's end (its newline, or `end`) and acting
+  // on nothing yet; read_matched() then reads and commits that line, and
+  // simdjson never sees it. Lines that do not match go through on_object()
+  // as before, in order.
   virtual bool reads_layouts() const { return false; }
-  virtual bool match_line(std::string_view) { return false; }
+  virtual const char* match_line(const char* /*p*/, const char* /*end*/) { return nullptr; }
   virtual void read_matched(const Position&) {}
 };
 

@@ -56,6 +56,8 @@ Pipeline::Pipeline(const std::vector<engine::PropertySpec>& properties, const Pi
                                           options.strict, options.robustness, options.layouts}),
       batch_reader_(*this, options.max_message_size) {
   make_typed_decoder();
+  fast_commit_ = !typed_ && !options_.on_message && !options_.parse_only && !options_.robustness &&
+                 options_.model == engine::TimeModel::Discrete;
   // --explain names the values a data reference decided on by their JSON
   // text; the decoders assign their ids. (A Pipeline never moves: its
   // reader already holds `this`.)
@@ -124,7 +126,17 @@ io::ReadResult Pipeline::on_object(const io::Position& where, simdjson::ondemand
 void Pipeline::read_matched(const io::Position& where) {
   std::string error;
   warnings_.clear();
-  if (!decoder_.decode_matched(error, &warnings_)) pending_rejection_ = error;
+  const bool decoded = decoder_.decode_matched(error, &warnings_);
+  if (decoded && warnings_.empty() && fast_commit_) {
+    // What commit() does for a plain discrete run, without the bookkeeping a
+    // message that may still be refused needs (the usual case by far).
+    decoder_.commit();
+    step_checker(where, [&] { checker_.step(decoder_.values(), decoder_.bound()); });
+    ++stats_.accepted;
+    ++stats_.by_layout;
+    return;
+  }
+  if (!decoded) pending_rejection_ = error;
   pending_ = true;
   pending_matched_ = true;
   pending_where_.emplace(where);
@@ -135,12 +147,11 @@ void Pipeline::read_matched(const io::Position& where) {
 // A data reference past --max-data-values stops the run: the error names
 // the message that brought the value too many.
 template <class F>
-void Pipeline::step_checker(F&& step) {
+void Pipeline::step_checker(const io::Position& where, F&& step) {
   try {
     step();
   } catch (const engine::data::DataLimitError& e) {
-    throw engine::data::DataLimitError(options_.position_name + " " + std::to_string(pending_where_->number()) + ": " +
-                                       e.what());
+    throw engine::data::DataLimitError(options_.position_name + " " + std::to_string(where.number()) + ": " + e.what());
   }
 }
 
@@ -174,7 +185,7 @@ void Pipeline::commit() {
     checker_.step_robust(margins());
   } else if (checker_.model() == engine::TimeModel::Discrete) {
     commit_values();
-    step_checker([&] { checker_.step(values(), bound()); });
+    step_checker(*pending_where_, [&] { checker_.step(values(), bound()); });
   } else {
     // Dense: this message closes [previous time, its time) with the previous values.
     double t = message_time();
@@ -187,7 +198,7 @@ void Pipeline::commit() {
       return;
     }
     if (checker_.robustness()) checker_.step_robust(begin, t, margins());
-    else step_checker([&] { checker_.step(begin, t, values(), bound()); });
+    else step_checker(*pending_where_, [&] { checker_.step(begin, t, values(), bound()); });
     commit_values();
     has_time_ = true;
     last_time_ = t;

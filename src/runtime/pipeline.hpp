@@ -71,7 +71,7 @@ class Pipeline final : public io::JsonlHandler, public Feed {
     pending_rejection_.clear();
   }
   bool reads_layouts() const override { return !typed_ && decoder_.learns_layouts(); }
-  bool match_line(std::string_view text) override { return decoder_.match(text); }
+  const char* match_line(const char* p, const char* end) override { return decoder_.match_line(p, end); }
   void read_matched(const io::Position& where) override;
   void on_error(const io::LineError& error) override;
   void on_warning(const io::LineError& warning) override;
@@ -97,7 +97,7 @@ class Pipeline final : public io::JsonlHandler, public Feed {
   void feed_typed(std::string_view sample, uint64_t position);
   void make_typed_decoder();
   template <class F>
-  void step_checker(F&& step);  // --type: the CDR decoder, over atoms_, after options_ are set
+  void step_checker(const io::Position& where, F&& step);  // --type: the CDR decoder, over atoms_, after options_ are set
   // The decoder of the message being committed.
   void commit_values() { typed_ ? typed_->commit() : decoder_.commit(); }
   const uint8_t* values() const { return typed_ ? typed_->values() : decoder_.values(); }
@@ -112,6 +112,7 @@ class Pipeline final : public io::JsonlHandler, public Feed {
   PipelineStats stats_;
   bool has_time_ = false;
   bool pending_ = false;        // decoded, waiting for commit()
+  bool fast_commit_ = false;     // read_matched() may step the checker at once (a discrete JSON run, see there)
   bool pending_matched_ = false;  // ... read by its layout (else by simdjson, and its layout may be learned)
   // Where the pending message came from. A copy, not a pointer: the reader's
   // Position may be a temporary that is gone by commit().

@@ -7,13 +7,17 @@
 //     (reading other fields) runs beside it — malformed JSON must be rejected
 //     whatever the properties read;
 //  2. file vs topic: the chunked file reader (`rvc check`) and one payload per
-//     line (`rvc monitor --input file:`) accept and reject the same messages.
+//     line (`rvc monitor --input file:`) accept and reject the same messages;
+//  3. layouts vs simdjson: reading lines by their learned layout
+//     (io/json_layout.hpp) gives the verdicts, the robustness values (bit for
+//     bit) and the counts that parsing every line with simdjson gives.
 #include <sys/mman.h>
 #include <unistd.h>
 
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -28,15 +32,22 @@ using rvc::runtime::PipelineOptions;
 
 struct Result {
   std::vector<std::pair<double, bool>> verdicts;  // property "a"
-  uint64_t accepted = 0, rejected = 0;
+  std::vector<uint64_t> robustness;               // its robustness values' bits (with robustness)
+  uint64_t accepted = 0, rejected = 0, warnings = 0;
 };
+
+void record(Result& r, const rvc::engine::Verdict& v) {
+  if (v.property != "a") return;
+  r.verdicts.emplace_back(v.time, v.value);
+  uint64_t bits;
+  std::memcpy(&bits, &v.robustness, sizeof bits);
+  r.robustness.push_back(bits);
+}
 
 Result run_file(const std::vector<PropertySpec>& props, const PipelineOptions& o, const std::string& text,
                 size_t chunk) {
   Result r;
-  Pipeline p(props, o, [&](const rvc::engine::Verdict& v) {
-    if (v.property == "a") r.verdicts.emplace_back(v.time, v.value);
-  });
+  Pipeline p(props, o, [&](const rvc::engine::Verdict& v) { record(r, v); });
   int fd = memfd_create("fuzz", 0);
   if (fd < 0 || write(fd, text.data(), text.size()) != static_cast<ssize_t>(text.size())) std::abort();
   lseek(fd, 0, SEEK_SET);
@@ -48,6 +59,7 @@ Result run_file(const std::vector<PropertySpec>& props, const PipelineOptions& o
   close(fd);
   r.accepted = p.stats().accepted;
   r.rejected = p.stats().rejected;
+  r.warnings = p.stats().warnings;
   return r;
 }
 
@@ -58,9 +70,7 @@ Result run_payloads(const std::vector<PropertySpec>& props, const PipelineOption
   Result r;
   PipelineOptions po = o;
   po.position_name = "seq";
-  Pipeline p(props, po, [&](const rvc::engine::Verdict& v) {
-    if (v.property == "a") r.verdicts.emplace_back(v.time, v.value);
-  });
+  Pipeline p(props, po, [&](const rvc::engine::Verdict& v) { record(r, v); });
   uint64_t line = 0;
   for (size_t at = 0; at < text.size();) {
     size_t nl = text.find('\n', at);
@@ -78,6 +88,7 @@ Result run_payloads(const std::vector<PropertySpec>& props, const PipelineOption
   }
   r.accepted = p.stats().accepted;
   r.rejected = p.stats().rejected;
+  r.warnings = p.stats().warnings;
   return r;
 }
 
@@ -104,5 +115,19 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (!o.strict && (a.verdicts != b.verdicts || a.accepted != b.accepted || a.rejected != b.rejected)) std::abort();
   Result c = run_payloads(alone, o, text);
   if (a.accepted != c.accepted || a.rejected != c.rejected || a.verdicts != c.verdicts) std::abort();
+  // 3: the same runs with every line parsed by simdjson, and with robustness
+  // values (flag 16), where a number read one bit differently shows.
+  PipelineOptions slow = o;
+  slow.layouts = false;
+  if (flags & 16) {
+    o.robustness = slow.robustness = true;
+    a = run_file(alone, o, text, chunk);
+  }
+  const auto same = [](const Result& x, const Result& y) {
+    return x.verdicts == y.verdicts && x.robustness == y.robustness && x.accepted == y.accepted &&
+           x.rejected == y.rejected && x.warnings == y.warnings;
+  };
+  if (!same(a, run_file(alone, slow, text, chunk))) std::abort();
+  if (!same(run_payloads(alone, o, text), run_payloads(alone, slow, text))) std::abort();
   return 0;
 }
