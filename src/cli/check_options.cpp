@@ -29,6 +29,8 @@ void CheckOptions::add_to(CLI::App& app) {
       ->capture_default_str();
   app.add_flag("--parse-only", parse_only, "Decode messages but run no monitor (the benchmark's floor)")
       ->group("");  // hidden: for bench/, not for users
+  app.add_flag("--no-layouts", no_layouts, "Parse every message with simdjson (no layout fast path)")
+      ->group("");  // hidden: for bench/ and for comparing the two paths
 }
 
 std::vector<engine::PropertySpec> CheckOptions::properties() const {
@@ -55,6 +57,7 @@ PipelineOptions CheckOptions::pipeline_options() const {
   o.time_field = time_field;
   o.max_reported = max_reported;
   o.parse_only = parse_only;
+  o.layouts = !no_layouts;
   o.robustness = robustness;
   o.explain = explain;
   o.max_data_values = max_data_values;

@@ -23,6 +23,7 @@ struct CheckOptions {
   size_t max_message_size = 1 << 20;
   size_t max_reported = 100;
   bool parse_only = false;
+  bool no_layouts = false;
   bool robustness = false;
   bool explain = false;
   uint32_t max_data_values = 100000;

@@ -51,7 +51,9 @@ class JsonDecoder {
   // be learned now (attempts back off while learned layouts go unused), and
   // learning it from the message's text.
   bool learns_layouts() const { return options_.layouts && !options_.strict; }
-  bool wants_layout() { return learns_layouts() && ++slow_since_learn_ >= learn_interval_; }
+  bool wants_layout() {
+    return learns_layouts() && resting_ < kLearnBeforeProbe && ++slow_since_learn_ >= learn_interval_;
+  }
   void learn(std::string_view line);
   size_t layouts() const { return layouts_.size(); }
 
@@ -165,6 +167,13 @@ class JsonDecoder {
   uint64_t uses_ = 0;
   std::vector<FieldValue> slot_values_;  // of the matched line
   uint32_t slow_since_learn_ = 0, learn_interval_ = 1;
+  // When layouts rarely match (a stream whose messages keep changing shape),
+  // trying them costs more than it saves: after a probe of kProbe tries with
+  // fewer than half matched, match_line() declines the next resting_ calls
+  // without trying, a span that doubles while probes keep failing. Layouts
+  // are learned again just before the next probe.
+  static constexpr uint32_t kProbe = 64, kFirstRest = 256, kMaxRest = 1 << 16, kLearnBeforeProbe = 16;
+  uint32_t tries_ = 0, hits_ = 0, resting_ = 0, rest_span_ = kFirstRest;
   simdjson::ondemand::parser learn_parser_;
   std::string learn_scratch_;
 };

@@ -141,6 +141,20 @@ void JsonDecoder::learn(std::string_view line) {
 
 const char* JsonDecoder::match_line(const char* p, const char* end) {
   if (layouts_.empty()) return nullptr;
+  if (resting_) {
+    --resting_;
+    return nullptr;
+  }
+  if (++tries_ == kProbe) {  // the last kProbe tries decide whether layouts pay here
+    if (hits_ * 2 < tries_) {
+      resting_ = rest_span_;
+      rest_span_ = std::min(rest_span_ * 2, kMaxRest);
+      learn_interval_ = 1;  // learn afresh before the next probe
+    } else {
+      rest_span_ = kFirstRest;
+    }
+    tries_ = hits_ = 0;
+  }
   while (p != end && (*p == ' ' || *p == '\t' || *p == '\r')) ++p;
   // The layout that matched last is the likeliest: try it first.
   for (size_t k = 0, n = layouts_.size(), i = matched_; k < n; ++k, i = i + 1 == n ? 0 : i + 1) {
@@ -155,6 +169,7 @@ const char* JsonDecoder::match_line(const char* p, const char* end) {
       matched_ = i;
       l.last_used = ++uses_;
     }
+    ++hits_;
     learn_interval_ = 1;
     return stop;
   }

@@ -104,15 +104,15 @@ TEST(JsonLayout, TextIsTheLineWithoutSurroundingWhitespace) {
 
 // ---- differential: layouts on vs off, through the whole pipeline ----
 
-struct Run {
+struct Outcome {
   std::vector<std::tuple<std::string, double, bool, uint64_t>> verdicts;  // robustness as its bits
   runtime::PipelineStats stats;
   std::string errors;
 };
 
-Run run(const std::vector<engine::PropertySpec>& properties, runtime::PipelineOptions options, const std::string& text,
+Outcome run(const std::vector<engine::PropertySpec>& properties, runtime::PipelineOptions options, const std::string& text,
         bool layouts, bool as_payloads) {
-  Run r;
+  Outcome r;
   options.layouts = layouts;
   options.max_reported = 1 << 30;
   testing::internal::CaptureStderr();
@@ -197,8 +197,8 @@ std::string random_trace(std::mt19937& rng, size_t lines) {
 
 void expect_same(const std::vector<engine::PropertySpec>& props, const runtime::PipelineOptions& o,
                  const std::string& text, bool payloads) {
-  Run fast = run(props, o, text, true, payloads);
-  Run slow = run(props, o, text, false, payloads);
+  Outcome fast = run(props, o, text, true, payloads);
+  Outcome slow = run(props, o, text, false, payloads);
   EXPECT_EQ(fast.verdicts, slow.verdicts);
   if (fast.errors != slow.errors) {  // the first line that differs, not pages of both
     size_t at = 0;
@@ -254,6 +254,46 @@ TEST(JsonLayoutDifferential, DenseTimeMatchesSimdjson) {
     expect_same({{"a", "{x > 0} since[0:2] ({y} or {s == \"w\"})"}, {"b", "once[1:3] {u.v >= 2.5}"}}, o, text, false);
     expect_same({{"a", "{x > 0} since[0:2] ({y} or {s == \"w\"})"}}, o, text, true);
   }
+}
+
+}  // namespace
+}  // namespace rvc
+
+namespace rvc {
+namespace {
+
+// A stretch where messages keep changing shape makes layouts rest (they would
+// cost more than they save); once the shape settles, they are back.
+TEST(JsonLayoutDifferential, LayoutsRestWhileShapesChurnAndComeBack) {
+  std::mt19937 rng(3);
+  std::string churn;
+  const char* keys[] = {"\"x\":", "\"y\":", "\"s\":", "\"time\":"};
+  for (int i = 0; i < 1000; ++i) {  // keys in a random order: 24 shapes
+    std::vector<int> order = {0, 1, 2, 3};
+    std::shuffle(order.begin(), order.end(), rng);
+    std::string line = "{";
+    for (int k : order) {
+      if (line.size() > 1) line += ",";
+      line += std::string(keys[k]) + (k == 1 ? (i % 3 ? "true" : "false") : k == 2 ? "\"w\"" : std::to_string(i % 7));
+    }
+    churn += line + "}\n";
+  }
+  std::string text = churn;
+  for (int i = 0; i < 5000; ++i)
+    text += "{\"time\":" + std::to_string(i) + ",\"x\":" + std::to_string(i % 5) + ",\"y\":" + (i % 4 ? "true" : "false") +
+            ",\"s\":\"v\"}\n";
+  runtime::PipelineOptions o;
+  o.emit_all = true;
+  const std::vector<engine::PropertySpec> props = {{"a", "{x > 2} since {y}"}};
+  Outcome fast = run(props, o, text, true, false);
+  Outcome slow = run(props, o, text, false, false);
+  EXPECT_EQ(fast.verdicts, slow.verdicts);
+  EXPECT_EQ(fast.stats.accepted, 6000u);
+  EXPECT_GT(fast.stats.by_layout, 3500u) << "layouts should be back once the shape settles";
+  // Tried on every line, 4 kept layouts of 24 shapes would match about 1 line in 6.
+  Outcome churning = run(props, o, churn, true, false);
+  EXPECT_LT(churning.stats.by_layout, 80u) << "layouts should rest while shapes churn";
+  EXPECT_EQ(churning.verdicts, run(props, o, churn, false, false).verdicts);
 }
 
 }  // namespace
