@@ -52,15 +52,20 @@ const char* scan_number(const char* p, const char* end, bool convert, double& ou
   const bool negative = *q == '-';
   if (negative && ++q == end) return nullptr;
   uint64_t mantissa = 0;
+  // A run of digits from q: its end, its digits folded into the mantissa when converting.
+  const auto run = [&](const char* q) {
+    if (convert)
+      for (; q != end && digit(*q); ++q) mantissa = mantissa * 10 + static_cast<unsigned>(*q - '0');
+    else
+      while (q != end && digit(*q)) ++q;
+    return q;
+  };
   int digits = 0, fraction = 0;
   if (*q == '0') {
     ++q;
   } else if (digit(*q)) {
     const char* first = q;
-    if (convert)
-      for (; q != end && digit(*q); ++q) mantissa = mantissa * 10 + static_cast<unsigned>(*q - '0');
-    else
-      while (q != end && digit(*q)) ++q;
+    q = run(q);
     digits = static_cast<int>(q - first);
   } else {
     return nullptr;
@@ -68,10 +73,7 @@ const char* scan_number(const char* p, const char* end, bool convert, double& ou
   if (q != end && *q == '.') {
     if (++q == end || !digit(*q)) return nullptr;
     const char* first = q;
-    if (convert)
-      for (; q != end && digit(*q); ++q) mantissa = mantissa * 10 + static_cast<unsigned>(*q - '0');
-    else
-      while (q != end && digit(*q)) ++q;
+    q = run(q);
     fraction = static_cast<int>(q - first);
     digits += fraction;
   }
@@ -147,8 +149,7 @@ JsonLayout::JsonLayout(std::string_view text, const std::vector<Range>& values, 
   size_t at = 0;
   for (size_t i = 0; i < values.size(); ++i) {
     const Range& r = values[i];
-    Slot slot{static_cast<uint32_t>(skeleton_.size()), static_cast<uint32_t>(r.begin - at)};
-    slot.convert = convert[i];
+    Slot slot{static_cast<uint32_t>(skeleton_.size()), static_cast<uint32_t>(r.begin - at), 0, 0, convert[i]};
     if (slot.before_len <= 8) {
       std::memcpy(&slot.word, text.data() + at, slot.before_len);
       slot.mask = slot.before_len == 8 ? ~uint64_t{0} : (uint64_t{1} << (8 * slot.before_len)) - 1;
