@@ -55,7 +55,6 @@ class JsonDecoder {
     return learns_layouts() && resting_ < kLearnBeforeProbe && ++slow_since_learn_ >= learn_interval_;
   }
   void learn(std::string_view line);
-  size_t layouts() const { return layouts_.size(); }
 
   // After decode() returned false: whether the JSON itself was malformed
   // (rather than valid JSON that the properties cannot use).

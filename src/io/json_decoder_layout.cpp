@@ -20,8 +20,6 @@ constexpr size_t kMaxLayouts = 4;
 // learned layouts go unused (a stream whose every line looks different).
 constexpr uint32_t kMaxLearnInterval = 1024;
 
-bool json_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; }
-
 }  // namespace
 
 struct JsonDecoder::LayoutWalk {

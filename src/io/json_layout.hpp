@@ -57,13 +57,14 @@ class JsonLayout {
   uint32_t tail_at_ = 0, tail_len_ = 0;  // the bytes after the last value
 };
 
+inline bool json_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; }
+
 // The text of a line as layouts see it: without the JSON whitespace around
 // it (a CR before the newline, indentation), so a CRLF file, and the same
 // line read as a file or a payload, give one layout.
 inline std::string_view layout_text(std::string_view line) {
-  const auto space = [](char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; };
-  while (!line.empty() && space(line.front())) line.remove_prefix(1);
-  while (!line.empty() && space(line.back())) line.remove_suffix(1);
+  while (!line.empty() && json_space(line.front())) line.remove_prefix(1);
+  while (!line.empty() && json_space(line.back())) line.remove_suffix(1);
   return line;
 }
 

@@ -95,9 +95,9 @@ class Pipeline final : public io::JsonlHandler, public Feed {
   void report(const std::string& text);
   bool oversized(std::string_view payload, uint64_t position);  // rejects it if so
   void feed_typed(std::string_view sample, uint64_t position);
-  void make_typed_decoder();
+  void make_typed_decoder();  // --type: the CDR decoder, over atoms_, after options_ are set
   template <class F>
-  void step_checker(const io::Position& where, F&& step);  // --type: the CDR decoder, over atoms_, after options_ are set
+  void step_checker(const io::Position& where, F&& step);  // a data-limit error names `where`
   // The decoder of the message being committed.
   void commit_values() { typed_ ? typed_->commit() : decoder_.commit(); }
   const uint8_t* values() const { return typed_ ? typed_->values() : decoder_.values(); }
