@@ -118,6 +118,38 @@ TEST(Pipeline, ObjectWithTrailingBraceIsOneRejectionNotTwoSteps) {
   EXPECT_EQ(r.stats.rejected, 1u);
 }
 
+// Was a bug (fixed; found by comparing the layout path with simdjson): a
+// payload refused at one field (dense time given as a string) was reported as
+// "unexpected text after the JSON object", because the decoder stopped
+// reading there and line mode took the rest for trailing text.
+TEST(Pipeline, APayloadRefusedAtAFieldIsReportedForThatField) {
+  PipelineOptions o;
+  o.model = engine::TimeModel::Dense;
+  o.position_name = "seq";
+  testing::internal::CaptureStderr();
+  {
+    Pipeline p({{"p1", "{p}"}}, o, [](const engine::Verdict&) {});
+    p.feed("{\"time\":\"soon\",\"p\":true}", 7);
+    EXPECT_EQ(p.stats().rejected, 1u);
+  }
+  const std::string err = testing::internal::GetCapturedStderr();
+  EXPECT_NE(err.find("rvc: seq 7: time field \"time\" must be a number of seconds or a Time {sec, nanosec}, not a "
+                     "string (message skipped)"),
+            std::string::npos)
+      << err;
+  EXPECT_EQ(err.find("unexpected text"), std::string::npos) << err;
+}
+
+// Was a bug (fixed): junk after an object on its line was reported without
+// its column when the line fell in a document stream, with it in line mode.
+// Now it is re-read in line mode wherever it falls: column 11 is the second '}'.
+TEST(Pipeline, TextAfterAnObjectIsReportedWithItsColumn) {
+  Result r = run({{"p1", "{p}"}}, discrete_all(), "{\"p\":true}\n{\"p\":true}}\n{\"p\":false}\n");
+  EXPECT_EQ(r.stats.rejected, 1u);
+  EXPECT_NE(r.stderr_text.find("rvc: line 2, column 11: unexpected text after the JSON object"), std::string::npos)
+      << r.stderr_text;
+}
+
 TEST(Pipeline, WarningsNameTheLine) {
   Result r = run({{"p1", "{x > 2}"}}, discrete_all(), "{\"x\":5}\n{\"x\":\"abc\"}\n{\"x\":1}\n");
   EXPECT_EQ(r.verdicts, (TVs{{0, true}, {1, true}, {2, false}}));  // line 2 keeps x > 2 true
