@@ -12,6 +12,7 @@
 # copied to build/fuzz/crashes/ and named in the output (rerun: build/fuzz/fuzz/fuzz_X FILE).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+. scripts/cache-env.sh  # ~/.cache/rvc: cargo target keyed by Cargo.lock, ccache
 ROOT=$PWD
 seconds=30
 only=""

@@ -7,6 +7,7 @@
 # Usage: scripts/sanitize.sh [asan|tsan]...   (default: both)
 set -euo pipefail
 cd "$(dirname "$0")/.."
+. scripts/cache-env.sh  # ~/.cache/rvc: cargo target keyed by Cargo.lock, ccache
 ROOT=$PWD
 tiers=("$@")
 [ ${#tiers[@]} -gt 0 ] || tiers=(asan tsan)
