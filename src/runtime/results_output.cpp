@@ -23,7 +23,7 @@ void ResultsOutput::finish(Outcome& outcome, const std::string& reason, const st
   const store::StoreStats s = store_->stats();
   // Rows the database refused are results it does not hold: not a success.
   if (s.refused) {
-    std::fprintf(stderr, "rvc: results database %s refused %llu row%s, which are not stored (the first: %s)\n",
+    std::fprintf(stderr, "rvc: results database %s refused %llu row%s: not stored (the first: %s)\n",
                  describe().c_str(), static_cast<unsigned long long>(s.refused), s.refused == 1 ? "" : "s",
                  s.first_refusal.c_str());
     outcome.runtime_failure = true;

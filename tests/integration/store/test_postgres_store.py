@@ -211,7 +211,9 @@ def test_b_outage_in_the_middle(rvc_pg, pg, tmp_path):
 # and the next run on that spool writes them (once).
 
 def spooled_tables(spool):
-    return [json.loads(l)["table"] for l in spool.read_text().splitlines() if l.strip()]
+    lines = [l for l in spool.read_text().splitlines() if l.strip()]
+    assert lines[0] == '{"rvc_spool":1}', lines[:1]  # rvc's own spool: its header first
+    return [json.loads(l)["table"] for l in lines[1:]]
 
 
 @pytest.mark.parametrize("away", ["from_the_start", "after_the_start"])

@@ -80,13 +80,26 @@ def test_check_on_a_pipe_stopped_by_a_signal_keeps_every_row(tmp_path, sig):
     run = LiveCheck(db)
     run.feed(0, 40)  # the pipe stays open: only the signal ends the run
     status, err = run.stop(sig)
-    assert status == 6, err  # the stream was cut: incomplete, as monitor's status for a signal
+    assert status == 1, err  # violated: it outranks the incomplete stream (6)
     assert "stopped by a signal after 40 messages" in err
     (ended, exit_status, reason, counters), = rows(db, "SELECT ended_at, exit_status, end_reason, counters FROM runs")
-    assert ended is not None and exit_status == 6 and reason == "signal"
+    assert ended is not None and exit_status == 1 and reason == "signal"
     assert json.loads(counters)["checked"] == 40
     assert rows(db, "SELECT time, value FROM verdicts ORDER BY id") == [(i, int(i % 2 == 0)) for i in range(40)]
     assert rows(db, "SELECT time FROM violations ORDER BY id") == [(i,) for i in range(1, 40, 2)]
+
+
+@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT])
+def test_check_stopped_by_a_signal_is_incomplete(tmp_path, sig):
+    db = tmp_path / "results.db"
+    run = LiveCheck(db)
+    run.proc.stdin.write('{"a":true}\n{"a":true}\n')
+    run.proc.stdin.flush()
+    assert run.verdicts.get(timeout=60) is not None  # {a}'s first verdict: the lines were read
+    status, err = run.stop(sig)
+    assert status == 6, err  # nothing violated, the trace cut: incomplete, as `rvc monitor` on a signal
+    assert rows(db, "SELECT exit_status, end_reason FROM runs WHERE ended_at IS NOT NULL") == [(6, "signal")]
+    assert rows(db, "SELECT time, value FROM verdicts") == [(0, 1)]
 
 
 # --- 2. a stop signal while the database is away: spooled at once, not after --db-wait
@@ -101,7 +114,7 @@ def test_signal_while_the_database_is_away_spools_at_once(tmp_path):
     try:
         run.feed(10, 30)
         status, err = run.stop(signal.SIGTERM)
-        assert status == 5, err  # not all results are in the database: a runtime failure
+        assert status == 1, err  # violated outranks the runtime failure (results not all in the database)
         spool = f"{db}.spool"
         m = re.search(r"(\d+) rows kept in (\S+) ", err)
         assert m and m.group(2) == spool, err
@@ -121,7 +134,7 @@ def test_signal_while_the_database_is_away_spools_at_once(tmp_path):
     first = rows(db, "SELECT run FROM runs ORDER BY run")[0][0]
     assert rows(db, f"SELECT time, value FROM verdicts WHERE run = '{first}' ORDER BY id") == \
         [(i, int(i % 2 == 0)) for i in range(40)]
-    assert rows(db, f"SELECT exit_status, end_reason FROM runs WHERE run = '{first}'") == [(6, "signal")]
+    assert rows(db, f"SELECT exit_status, end_reason FROM runs WHERE run = '{first}'") == [(1, "signal")]
 
 
 # --- 3. a full disk: what is said about the rows is true
@@ -183,7 +196,7 @@ def test_refused_rows_give_status_5_with_count_and_reason(tmp_path):
                        capture_output=True, text=True, timeout=60)
     # Both hold; p2's one verdict change (its first verdict) is refused: 1 row, with the reason.
     assert r.returncode == 5, r.stderr
-    assert re.search(r"refused 1 row, which are not stored \(the first: a verdict row: .*p2 is not welcome",
+    assert re.search(r"refused 1 row: not stored \(the first: a verdict row: .*p2 is not welcome",
                      r.stderr), r.stderr
 
 
