@@ -239,8 +239,7 @@ void DashboardServer::Impl::serve_events(const httplib::Request& req, httplib::R
   if (streams.fetch_add(1) >= options.max_streams) {
     streams--;
     reply(res, error_response(503, "too many event streams (at most " + std::to_string(options.max_streams) + ")"));
-    res.set_header("Connection", "close");
-    return;
+    return;  // and the connection closes, as every one does after its response
   }
   auto stream = std::make_shared<Stream>();
   try {

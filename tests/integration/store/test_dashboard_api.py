@@ -182,6 +182,10 @@ class Events:
         return None
 
     def close(self):
+        # The server closes every connection after its response ("Connection: close"), so
+        # http.client hands the socket to the response: closing the connection alone would
+        # leave it open.
+        self.resp.close()
         self.conn.close()
 
 
