@@ -503,6 +503,30 @@ def test_explanations_kept_and_an_older_database_gains_their_column(tmp_path):
         assert d.stop() == 0
 
 
+def test_an_older_database_is_served_as_it_is(tmp_path):
+    """A database from before explanations (violations without the column) is read, not migrated:
+    the dashboard opens it read-only, its violations have null explanations, and its bytes stay."""
+    import hashlib
+    db = tmp_path / "old.db"
+    with sqlite3.connect(db) as c:
+        for sql in SCHEMA:
+            c.execute(sql.replace(", explanation TEXT)", ")"))
+        c.execute("INSERT INTO runs (run, command, started_at) VALUES ('r1', 'rvc check', 1)")
+        c.execute("INSERT INTO violations (run, property, time, wall, witness) VALUES ('r1', 'p1', 3, 4, '[]')")
+    before = hashlib.sha256(db.read_bytes()).hexdigest()
+    d = Dashboard(f"sqlite:{db}")
+    try:
+        status, body = d.get("/api/runs/r1/violations")
+        assert status == 200 and [(v["time"], v["explanation"]) for v in body["violations"]] == [(3, None)]
+        ev = Events(d.port, "/api/events?run=r1&verdict=0&violation=0&counters=0")
+        event = ev.next(timeout=5)
+        assert event is not None and event[0] == "violation" and event[1][0]["explanation"] is None
+        ev.close()
+    finally:
+        assert d.stop() == 0
+    assert hashlib.sha256(db.read_bytes()).hexdigest() == before
+
+
 # --- the same API over PostgreSQL ------------------------------------------------------------------
 
 def test_postgresql_database(rvc_pg, pg, tmp_path):
