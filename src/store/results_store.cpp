@@ -460,7 +460,12 @@ bool ResultsStore::drain_spool() {
   while (done < rows.size()) {
     const size_t n = std::min(kBatchRows, rows.size() - done);
     std::vector<Row> batch(std::make_move_iterator(rows.begin() + done), std::make_move_iterator(rows.begin() + done + n));
-    if (!write_batch(batch)) {
+    // A second stop signal while the run ends: the rest stays in the spool.
+    const bool cut = [this] {
+      std::lock_guard<std::mutex> lock(mutex_);
+      return stopping_;
+    }() && cut_wait();
+    if (cut || !write_batch(batch)) {
       // Keep what is not written yet, and only that: a later drain must not
       // write the committed batches twice.
       // (write_batch may have kept only the rows after a lost connection.)
@@ -607,7 +612,9 @@ bool ResultsStore::finish(double wait_seconds) {
   }
   const bool stopped = options_.stop_signals && options_.stop_signals() > 0;
   char waited[96];
-  if (stopped)
+  if (cut_wait())
+    std::snprintf(waited, sizeof waited, "was still being written when a second stop signal cut the wait");
+  else if (stopped)
     std::snprintf(waited, sizeof waited, "is away and the run was stopped by a signal (no waiting)");
   else
     std::snprintf(waited, sizeof waited, "did not come back within %.1f s", wait_seconds);
