@@ -71,6 +71,9 @@ struct CheckCommand {
     sinks.push_back(std::make_unique<transport::FileSink>(opath));
     runtime::VerdictOutputs outputs(std::move(sinks), !check.dense);
     runtime::PipelineOptions popts = check.pipeline_options();
+    // A bad spec ends the run before the database is opened: a refused run
+    // creates no results file.
+    if (!store.database.empty()) runtime::check_specs(properties, check.dense);
     auto results = store.open();
     if (results) results->attach(input, popts, outputs);
     runtime::Pipeline pipeline(properties, popts, [&](const engine::Verdict& v) { outputs.put(v); });

@@ -324,3 +324,12 @@ def test_rvc_databases_old_and_new_are_accepted_and_the_dashboard_changes_neithe
     with sqlite3.connect(old) as c:
         assert c.execute("PRAGMA application_id").fetchone() == (0x72766331,)
         assert len(c.execute("SELECT * FROM runs").fetchall()) == 1
+
+
+def test_a_run_refused_for_its_spec_creates_no_database(tmp_path):
+    trace = tmp_path / "t.jsonl"
+    trace.write_text('{"a":true}\n')
+    r = subprocess.run([rvc_binary(), "check", "-s", "{a", "-o", f"sqlite:{tmp_path}/new.db", str(trace)],
+                       capture_output=True, text=True, timeout=60)
+    assert r.returncode == 2, r.stderr
+    assert sorted(os.listdir(tmp_path)) == ["t.jsonl"]  # no database, no spool, no lock
