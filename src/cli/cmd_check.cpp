@@ -9,6 +9,7 @@
 
 #include "cli/check_options.hpp"
 #include "cli/commands.hpp"
+#include "cli/signals.hpp"
 #include "cli/store_options.hpp"
 #include "io/json_writer.hpp"
 #include "cli/sync_options.hpp"
@@ -70,17 +71,35 @@ struct CheckCommand {
     sinks.push_back(std::make_unique<transport::FileSink>(opath));
     runtime::VerdictOutputs outputs(std::move(sinks), !check.dense);
     runtime::PipelineOptions popts = check.pipeline_options();
+    // A bad spec ends the run before the database is opened: a refused run
+    // creates no results file.
+    if (!store.database.empty()) runtime::check_specs(properties, check.dense);
     auto results = store.open();
     if (results) results->attach(input, popts, outputs);
     runtime::Pipeline pipeline(properties, popts, [&](const engine::Verdict& v) { outputs.put(v); });
     if (results) results->start(runtime::run_info(command_line(), {input}, properties, check.dense));
     io::ReaderOptions ropts;
     ropts.max_line_bytes = check.max_message_size;
+    // SIGINT/SIGTERM end the input where it is, as `rvc monitor`'s: what was
+    // read is checked, verdicts and results are flushed, the run is closed.
+    install_stop_signals();
+    end_input_on_stop(fd);
     // Reading stdin: show each verdict as soon as it is known.
     runtime::Outcome outcome = runtime::check_stream(fd, pipeline, outputs, ropts, path == "-");
+    end_input_on_stop(-1);
     if (fd != 0) ::close(fd);
     report(pipeline.stats(), pipeline.violations());
-    if (results) results->finish(outcome, "end of input", counters_json(pipeline.stats(), pipeline.violations()));
+    const bool stopped = stop_requested();
+    if (stopped) {
+      // Not a pass: the input was cut (monitor's status for a stop signal).
+      std::fprintf(stderr, "rvc: stopped by a signal after %llu messages: %s was not read to its end\n",
+                   static_cast<unsigned long long>(pipeline.stats().accepted + pipeline.stats().rejected),
+                   path == "-" ? "stdin" : path.c_str());
+      outcome.incomplete = true;
+    }
+    if (results)
+      results->finish(outcome, stopped ? "signal" : "end of input",
+                      counters_json(pipeline.stats(), pipeline.violations()));
     return outcome.exit_code();
   }
 
@@ -162,7 +181,8 @@ Runner register_check(CLI::App& app) {
   sub->add_flag("--summary", cmd->summary, "Print message counts to stderr at the end");
   sub->footer(
       "Exit status: 0 all properties held, 1 a property was violated, 2 usage or spec error, 3 messages were\n"
-      "rejected, 5 runtime failure (the trace could not be read, verdicts could not be written).\n"
+      "rejected, 5 runtime failure (the trace could not be read, verdicts or results could not be written),\n"
+      "6 stopped by SIGINT/SIGTERM before the end of the trace (what was read is checked and stored).\n"
       "Example: rvc check --spec 'historically({emergency} -> once[0:1]{hazard_lights})' trace.jsonl");
   return [cmd] { return cmd->run(); };
 }

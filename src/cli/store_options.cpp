@@ -2,6 +2,8 @@
 
 #include <cstdio>
 
+#include "cli/signals.hpp"
+
 namespace rvc::cli {
 
 namespace {
@@ -52,7 +54,9 @@ bool StoreFlags::take_database(std::vector<std::string>& outputs) {
 
 std::unique_ptr<runtime::ResultsOutput> StoreFlags::open() const {
   if (database.empty()) return nullptr;
-  return std::make_unique<runtime::ResultsOutput>(database, options);
+  store::StoreOptions o = options;
+  o.stop_signals = stop_signals;  // a stopped run spools at once; a second signal cuts any wait
+  return std::make_unique<runtime::ResultsOutput>(database, o);
 }
 
 }  // namespace rvc::cli

@@ -249,6 +249,19 @@ QueryResult rows_after(Database& db, const char* columns, const char* table, con
 
 const char* const kVerdictColumns = "id, property, time, value, wall";
 const char* const kViolationColumns = "id, property, time, wall, witness, explanation";
+
+// A database written by an rvc before explanations were stored has no such
+// column, and the dashboard reads databases as they are (it never migrates
+// one): its violations have null explanations.
+const char* violation_columns(Database& db) {
+  try {
+    db.query("SELECT explanation FROM violations LIMIT 0");
+    return kViolationColumns;
+  } catch (const store::DbError& e) {
+    if (e.connection_lost()) throw;
+    return "id, property, time, wall, witness, NULL AS explanation";
+  }
+}
 const char* const kCounterColumns = "id, wall, counters";
 
 // A page of rows: {"run":..,"after":..,"<key>":[..],"last_id":..,"more":..}.
@@ -436,7 +449,7 @@ Response handle_api(Database& db, const std::string& path, const Params& params)
         return follow(db, rest.substr(0, rest.size() - 9), params, kVerdictColumns, "verdicts", "verdicts",
                       kVerdictsDefault, kVerdictsMax, verdict_object);
       if (ends_with(rest, "/violations"))
-        return follow(db, rest.substr(0, rest.size() - 11), params, kViolationColumns, "violations", "violations",
+        return follow(db, rest.substr(0, rest.size() - 11), params, violation_columns(db), "violations", "violations",
                       kViolationsDefault, kViolationsMax, violation_object);
       if (ends_with(rest, "/counters")) return counters(db, rest.substr(0, rest.size() - 9), params);
       return run_detail(db, rest, params);
@@ -505,7 +518,7 @@ std::string poll_events(Database& db, EventCursor& cursor) {
       for (const Row& r : rows) a.add(verdict_object(r));
       return a.str();
     });
-    follow_table("violation", kViolationColumns, "violations", cursor.violation, 200, [](const QueryResult& rows) {
+    follow_table("violation", violation_columns(db), "violations", cursor.violation, 200, [](const QueryResult& rows) {
       io::JsonArray a;
       for (const Row& r : rows) a.add(violation_object(r));
       return a.str();

@@ -31,6 +31,8 @@ using Clock = std::chrono::steady_clock;
 constexpr auto kKeepAlive = std::chrono::seconds(2);  // a comment line this often: proxies keep the stream,
                                                       // and a closed client shows as a failed write
 constexpr size_t kIdleConnections = 4;
+constexpr time_t kIdleSeconds = 2;   // longest silence of a client before its connection is closed
+constexpr size_t kApiThreads = 24;   // server threads besides those of event streams
 
 // Database connections, one per request at a time (Database is not
 // thread-safe); idle ones are kept, so a poll does not reopen the file.
@@ -46,7 +48,7 @@ class Pool {
         return db;
       }
     }
-    return store::open_database(uri_);
+    return store::open_database_readonly(uri_);  // it never writes, not even a schema
   }
   void give(std::unique_ptr<store::Database> db) {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -208,9 +210,18 @@ void DashboardServer::Impl::routes() {
     int yes = 1;
     ::setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
   });
-  // Event streams hold a thread each for as long as they last; the pool is
-  // sized so that the page and API calls still find threads.
-  const size_t threads = static_cast<size_t>(options.max_streams) + 8;
+  // A connection holds a server thread from its accept to its close, so no
+  // client may keep one without doing anything: a request must arrive within
+  // kIdleSeconds and its bytes keep coming (a read waits at most that long),
+  // and every connection closes after one response (no idle keep-alive; on
+  // loopback a new connection costs nothing). Event streams hold a thread
+  // each for as long as they last (at most max_streams; more get a 503 and
+  // the connection closes); the rest of the pool answers the page and API.
+  http.set_read_timeout(kIdleSeconds, 0);
+  http.set_keep_alive_timeout(kIdleSeconds);
+  http.set_keep_alive_max_count(1);
+  http.set_write_timeout(5, 0);
+  const size_t threads = static_cast<size_t>(options.max_streams) + kApiThreads;
   http.new_task_queue = [threads] { return new httplib::ThreadPool(threads); };
 }
 
@@ -228,7 +239,7 @@ void DashboardServer::Impl::serve_events(const httplib::Request& req, httplib::R
   if (streams.fetch_add(1) >= options.max_streams) {
     streams--;
     reply(res, error_response(503, "too many event streams (at most " + std::to_string(options.max_streams) + ")"));
-    return;
+    return;  // and the connection closes, as every one does after its response
   }
   auto stream = std::make_shared<Stream>();
   try {

@@ -21,10 +21,17 @@ void ResultsOutput::attach(const std::string& input_name, PipelineOptions& optio
 void ResultsOutput::finish(Outcome& outcome, const std::string& reason, const std::string& final_counters) {
   if (!store_->end_run(outcome.exit_code(), reason, final_counters)) outcome.runtime_failure = true;
   const store::StoreStats s = store_->stats();
+  // Rows the database refused are results it does not hold: not a success.
+  if (s.refused) {
+    std::fprintf(stderr, "rvc: results database %s refused %llu row%s: not stored (the first: %s)\n",
+                 describe().c_str(), static_cast<unsigned long long>(s.refused), s.refused == 1 ? "" : "s",
+                 s.first_refusal.c_str());
+    outcome.runtime_failure = true;
+  }
   std::fprintf(stderr, "rvc: results in %s, run %s: %llu verdict changes, %llu violations%s\n", describe().c_str(),
                run_id().c_str(), static_cast<unsigned long long>(s.verdicts),
                static_cast<unsigned long long>(s.violations),
-               s.left_in_spool ? " (some still in the spool)" : "");
+               s.lost ? " (some lost)" : s.left_in_spool ? " (some still in the spool)" : "");
 }
 
 void check_specs(const std::vector<engine::PropertySpec>& properties, bool dense) {

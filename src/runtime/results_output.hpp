@@ -31,7 +31,8 @@ class ResultsOutput {
   void start(const store::RunInfo& run) { store_->begin_run(run); }
   void counters(const std::string& json) { store_->on_counters(json); }
   // After the run: its end, then waits for the writer. A store that could
-  // not write everything (the database stayed away) is a runtime failure.
+  // not write everything (the database stayed away, rows it refused, a spool
+  // that could not be written) is a runtime failure.
   void finish(Outcome& outcome, const std::string& reason, const std::string& final_counters);
 
   const std::string& run_id() const { return store_->run_id(); }

@@ -19,12 +19,26 @@ std::unique_ptr<Database> open_database(const std::string& uri) {
     if (path.empty()) throw DbError("sqlite: needs a file path (sqlite:results.db)");
     db = open_sqlite(path);
   } else if (starts_with(uri, "postgresql://") || starts_with(uri, "postgres://")) {
+    check_postgres_conninfo(uri);  // a typo is a usage error, not a server to wait for
     db = open_postgres(uri);
   } else {
     throw DbError("'" + uri + "' is not a results database (sqlite:PATH or postgresql://...)");
   }
   db->ensure_schema();
   return db;
+}
+
+std::unique_ptr<Database> open_database_readonly(const std::string& uri) {
+  if (starts_with(uri, "sqlite:")) {
+    const std::string path = uri.substr(7);
+    if (path.empty()) throw DbError("sqlite: needs a file path (sqlite:results.db)");
+    return open_sqlite(path, /*read_only=*/true);
+  }
+  if (starts_with(uri, "postgresql://") || starts_with(uri, "postgres://")) {
+    check_postgres_conninfo(uri);
+    return open_postgres(uri);
+  }
+  throw DbError("'" + uri + "' is not a results database (sqlite:PATH or postgresql://...)");
 }
 
 namespace {

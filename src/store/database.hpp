@@ -58,12 +58,25 @@ std::unique_ptr<Database> open_database(const std::string& uri);
 // Still throws for a bad URI or a file that cannot be opened.
 std::unique_ptr<Database> open_database_when_reachable(const std::string& uri);
 
+// For readers (the dashboard): opens a database rvc wrote, changing nothing:
+// SQLite read-only (no journal mode, no tables created; a file that is not
+// rvc's is refused), PostgreSQL without the schema statements. Throws DbError.
+std::unique_ptr<Database> open_database_readonly(const std::string& uri);
+
 // `uri` (or any argument) without a password: "postgresql://u:secret@h/db"
 // -> "postgresql://u@h/db", "...?password=secret" -> "...?password=***".
 std::string redact_password(const std::string& text);
 
+// Throws DbError (a usage error, not an outage) for a PostgreSQL URI that
+// no server could make work: what libpq cannot parse (an unclosed [IPv6
+// bracket), a port outside 1-65535, a value libpq would refuse at connect
+// time (sslmode=bogus). open_database() calls it before connecting.
+void check_postgres_conninfo(const std::string& conninfo);
+
 // The backends (open_database picks one by scheme).
-std::unique_ptr<Database> open_sqlite(const std::string& path);
+// `read_only`: for readers; else created if missing (and stamped as rvc's).
+// Either way an existing file that is not rvc's is refused unchanged.
+std::unique_ptr<Database> open_sqlite(const std::string& path, bool read_only = false);
 std::unique_ptr<Database> open_postgres(const std::string& conninfo);
 
 }  // namespace rvc::store

@@ -325,7 +325,58 @@ class PostgresDatabase final : public Database {
   std::set<Table> prepared_;  // statements this session has prepared
 };
 
+// Values libpq accepts for its enumerated options (libpq's documentation,
+// "Parameter Key Words"); anything else fails every connection attempt.
+const char* allowed_values(std::string_view keyword) {
+  if (keyword == "sslmode") return "disable allow prefer require verify-ca verify-full";
+  if (keyword == "gssencmode" || keyword == "channel_binding") return "disable prefer require";
+  if (keyword == "target_session_attrs") return "any read-write read-only primary standby prefer-standby";
+  if (keyword == "load_balance_hosts") return "disable random";
+  return nullptr;
+}
+
+bool all_digits(std::string_view s) { return !s.empty() && s.find_first_not_of("0123456789") == std::string_view::npos; }
+
 }  // namespace
+
+void check_postgres_conninfo(const std::string& conninfo) {
+  const std::string shown = redact_password(conninfo);
+  char* message = nullptr;
+  PQconninfoOption* options = libpq().PQconninfoParse(conninfo.c_str(), &message);
+  if (!options) {
+    const std::string why = message ? one_line(message) : "out of memory";
+    if (message) libpq().PQfreemem(message);
+    throw DbError("bad PostgreSQL URI '" + shown + "': " + why);
+  }
+  std::string problem;
+  for (auto* o = options; o->keyword && problem.empty(); ++o) {
+    if (!o->val) continue;
+    const std::string_view keyword = o->keyword, value = o->val;
+    if (keyword == "port") {
+      // One port, or one per host (host=a,b port=5432,5433); empty: the default.
+      size_t start = 0;
+      for (;;) {
+        const size_t comma = value.find(',', start);
+        const std::string_view port = value.substr(start, comma == std::string_view::npos ? comma : comma - start);
+        if (!port.empty() && (!all_digits(port) || port.size() > 5 || std::stoi(std::string(port)) < 1 ||
+                              std::stoi(std::string(port)) > 65535))
+          problem = "port '" + std::string(port) + "' is not a port number (1 to 65535)";
+        if (comma == std::string_view::npos || !problem.empty()) break;
+        start = comma + 1;
+      }
+    } else if (const char* allowed = allowed_values(keyword)) {
+      const std::string words = std::string(" ") + allowed + " ";
+      if (words.find(" " + std::string(value) + " ") == std::string::npos)
+        problem = std::string(keyword) + "=" + std::string(value) + " is not one of: " + allowed;
+    } else if (keyword == "connect_timeout" || keyword.rfind("keepalives", 0) == 0 ||
+               keyword == "tcp_user_timeout") {
+      if (!value.empty() && !all_digits(value))
+        problem = std::string(keyword) + "=" + std::string(value) + " is not a whole number";
+    }
+  }
+  libpq().PQconninfoFree(options);
+  if (!problem.empty()) throw DbError("bad PostgreSQL URI '" + shown + "': " + problem);
+}
 
 std::unique_ptr<Database> open_postgres(const std::string& conninfo) {
   return std::make_unique<PostgresDatabase>(conninfo);

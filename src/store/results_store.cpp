@@ -1,13 +1,18 @@
 #include "store/results_store.hpp"
 
 #include <fcntl.h>
+#include <pthread.h>
 #include <simdjson.h>
 #include <sys/file.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
 #include <chrono>
+#include <csignal>
+#include <cstring>
 #include <cstdio>
 #include <ctime>
 #include <fstream>
@@ -54,35 +59,63 @@ std::string default_spool(const std::string& description) {
   return name.substr(0, 120) + ".spool";
 }
 
+// Why `path` cannot be used as a spool, or "" if it can: it does not exist
+// yet, or it is a regular file that starts with rvc's spool header (or, as
+// spools written before the header, with a spooled row).
+std::string not_a_spool(const std::string& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) return errno == ENOENT ? "" : std::strerror(errno);
+  if (!S_ISREG(st.st_mode)) return "it is not a regular file";
+  if (st.st_size == 0) return "it is an empty file that rvc did not write";
+  std::ifstream in(path);
+  std::string first, error;
+  std::getline(in, first);
+  Row row;
+  if (first == kSpoolHeader || from_spool_line(first, row, error)) return "";
+  return std::string("its first line is not rvc's spool header ") + kSpoolHeader;
+}
+
 }  // namespace
 
 ResultsStore::ResultsStore(std::unique_ptr<Database> db, StoreOptions options)
     : db_(std::move(db)), options_(std::move(options)), description_(db_->describe()) {
   if (options_.spool.empty()) options_.spool = default_spool(description_);
+  // A spool is read, cut and deleted: a file that is not one is refused as
+  // it is (an input named by mistake, the database itself).
+  if (const std::string why = not_a_spool(options_.spool); !why.empty())
+    throw DbError("results spool '" + options_.spool + "' cannot be used: " + why +
+                  " (name a new file with --spool, or remove it)");
   // Two processes must not append to, drain and cut the same spool: the
   // second one on a spool that is taken uses its own.
   for (int attempt = 0; attempt < 2; ++attempt) {
-    spool_lock_ = ::open((options_.spool + ".lock").c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    const std::string lock = options_.spool + ".lock";
+    spool_lock_ = ::open(lock.c_str(), O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+    lock_created_ = spool_lock_ >= 0;
+    if (spool_lock_ < 0) spool_lock_ = ::open(lock.c_str(), O_RDWR | O_CLOEXEC);  // rvc's or another's: kept
     if (spool_lock_ >= 0 && ::flock(spool_lock_, LOCK_EX | LOCK_NB) == 0) break;
     if (spool_lock_ >= 0) ::close(spool_lock_);
+    if (lock_created_) ::unlink(lock.c_str());
     spool_lock_ = -1;
+    lock_created_ = false;
     if (attempt == 0) {
       const std::string own = options_.spool + "." + std::to_string(::getpid());
       std::fprintf(stderr, "rvc: results spool %s is in use by another rvc: using %s\n", options_.spool.c_str(),
                    own.c_str());
       options_.spool = own;
+      if (const std::string why = not_a_spool(own); !why.empty())
+        throw DbError("results spool '" + own + "' cannot be used: " + why + " (remove it)");
     }
   }
   ring_.resize(options_.witness);
   // An earlier run's spool is written before anything of this run.
-  if (std::ifstream(options_.spool).good()) spooling_ = true;
-  writer_ = std::thread([this] { writer_loop(); });
+  struct stat st {};
+  if (::stat(options_.spool.c_str(), &st) == 0) spooling_ = true;
 }
 
 ResultsStore::~ResultsStore() {
   if (!done_) finish(0);
   if (spool_lock_ >= 0) {
-    ::unlink((options_.spool + ".lock").c_str());
+    if (lock_created_) ::unlink((options_.spool + ".lock").c_str());
     ::close(spool_lock_);
   }
 }
@@ -94,6 +127,27 @@ void ResultsStore::push(Row row) {
 }
 
 void ResultsStore::begin_run(const RunInfo& info) {
+  for (const std::string& uri : info.inputs) {
+    std::string path = uri;
+    for (const char* scheme : {"file:", "mcap:"})
+      if (path.rfind(scheme, 0) == 0) path = path.substr(std::strlen(scheme));
+    struct stat a {}, b {};
+    if (path != "-" && ::stat(path.c_str(), &a) == 0 && ::stat(options_.spool.c_str(), &b) == 0 &&
+        a.st_dev == b.st_dev && a.st_ino == b.st_ino)
+      throw DbError("results spool '" + options_.spool + "' is the input '" + uri +
+                    "': it would be read as a spool, then deleted (name another file with --spool)");
+  }
+  if (!started_) {
+    // The writer never takes a stop signal: it goes to the thread that
+    // reads, whose read it ends (cli/signals.hpp).
+    sigset_t block, saved;
+    sigemptyset(&block);
+    for (int sig : {SIGINT, SIGTERM, SIGUSR1, SIGHUP}) sigaddset(&block, sig);
+    pthread_sigmask(SIG_BLOCK, &block, &saved);
+    writer_ = std::thread([this] { writer_loop(); });
+    pthread_sigmask(SIG_SETMASK, &saved, nullptr);
+    started_ = true;
+  }
   run_ = new_run_id();
   io::JsonArray inputs;
   for (const auto& name : info.inputs) {
@@ -211,7 +265,10 @@ bool ResultsStore::end_run(int exit_status, std::string_view reason, std::string
   end.number[1] = wall_now();
   end.integer = exit_status;
   push(std::move(end));
-  return finish(options_.wait_seconds);
+  // Stopped by a signal: whatever waits for the database goes to the spool
+  // now (docker's grace period is short, and a second signal is a SIGKILL).
+  const bool stopped = options_.stop_signals && options_.stop_signals() > 0;
+  return finish(stopped ? 0 : options_.wait_seconds);
 }
 
 StoreStats ResultsStore::stats() const {
@@ -220,6 +277,42 @@ StoreStats ResultsStore::stats() const {
 }
 
 // Writer thread -------------------------------------------------------------
+
+namespace {
+constexpr uint64_t kReportedOutages = 3;  // then counted, and summed up at the end
+}
+
+void ResultsStore::went_away(const std::string& why) {
+  connected_ = false;
+  if (away_) return;
+  away_ = true;
+  uint64_t outages;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    outages = ++stats_.outages;
+  }
+  if (outages <= kReportedOutages)
+    std::fprintf(stderr, "rvc: results database %s: %s; keeping results and retrying\n", description_.c_str(),
+                 why.c_str());
+  if (outages == kReportedOutages)
+    std::fprintf(stderr, "rvc: results database %s keeps going away: further outages are counted, not printed\n",
+                 description_.c_str());
+}
+
+// "Back" only once a write went through: a database that accepts the
+// reconnection and fails the next write (a full disk) stays away, silently.
+void ResultsStore::wrote() {
+  if (!away_) return;
+  away_ = false;
+  uint64_t outages;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    outages = stats_.outages;
+    ++stats_.reconnects;
+  }
+  if (outages <= kReportedOutages)
+    std::fprintf(stderr, "rvc: results database %s is back: writing what was kept\n", description_.c_str());
+}
 
 bool ResultsStore::write_batch(std::vector<Row>& batch) {
   if (batch.empty()) return true;
@@ -232,12 +325,10 @@ bool ResultsStore::write_batch(std::vector<Row>& batch) {
       write_one_by_one(batch);
       return connected_;
     }
-    if (connected_)
-      std::fprintf(stderr, "rvc: results database %s: %s; keeping results and retrying\n", description_.c_str(),
-                   e.what());
-    connected_ = false;
+    went_away(e.what());
     return false;
   }
+  wrote();
   std::lock_guard<std::mutex> lock(mutex_);
   stats_.rows += batch.size();
   for (const Row& r : batch) {
@@ -252,13 +343,14 @@ void ResultsStore::write_one_by_one(std::vector<Row>& batch) {
   for (size_t i = 0; i < batch.size(); ++i) {
     try {
       db_->write({batch[i]});
+      wrote();
       std::lock_guard<std::mutex> lock(mutex_);
       ++stats_.rows;
       stats_.verdicts += batch[i].table == Table::Verdict;
       stats_.violations += batch[i].table == Table::Violation;
     } catch (const DbError& e) {
       if (e.connection_lost()) {  // gone in the middle: the rest waits
-        connected_ = false;
+        went_away(e.what());
         rest.assign(std::make_move_iterator(batch.begin() + i), std::make_move_iterator(batch.end()));
         break;
       }
@@ -266,6 +358,7 @@ void ResultsStore::write_one_by_one(std::vector<Row>& batch) {
       {
         std::lock_guard<std::mutex> lock(mutex_);
         refused = ++stats_.refused;
+        if (refused == 1) stats_.first_refusal = std::string("a ") + table_name(batch[i].table) + " row: " + e.what();
       }
       if (refused <= 10)
         std::fprintf(stderr, "rvc: results database %s refused a %s row of run %s: %s\n", description_.c_str(),
@@ -275,22 +368,75 @@ void ResultsStore::write_one_by_one(std::vector<Row>& batch) {
   batch = std::move(rest);
 }
 
-void ResultsStore::spill(std::vector<Row>& rows) {
-  if (rows.empty()) return;
-  std::ofstream out(options_.spool, std::ios::app);
-  for (const Row& r : rows) out << to_spool_line(r) << '\n';
-  out.flush();
-  if (!out) {
-    // No database and no disk: keep them in memory (the end reports them).
-    std::fprintf(stderr, "rvc: cannot write the results spool %s: keeping %zu rows in memory\n",
-                 options_.spool.c_str(), rows.size());
-    pending_.insert(pending_.end(), rows.begin(), rows.end());
-  } else {
-    spooling_ = true;
+// Appends the rows (after the header, in a new spool) and makes sure they
+// are there: written whole, synced to the disk, and the file grown by exactly
+// their size. On any failure the file is cut back to where it was (no half
+// row), and removed if this call created it.
+bool ResultsStore::append_to_spool(const std::vector<Row>& rows, std::string& error) {
+  struct stat st {};
+  const bool fresh = ::stat(options_.spool.c_str(), &st) != 0;
+  const int fd = ::open(options_.spool.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
+  if (fd < 0) {
+    error = std::strerror(errno);
+    return false;
+  }
+  off_t before = 0;
+  if (::fstat(fd, &st) == 0) before = st.st_size;
+  std::string text;
+  if (before == 0) text = std::string(kSpoolHeader) + '\n';
+  for (const Row& r : rows) text += to_spool_line(r) + '\n';
+  bool ok = true;
+  for (size_t done = 0; ok && done < text.size();) {
+    const ssize_t n = ::write(fd, text.data() + done, text.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      error = n < 0 ? std::strerror(errno) : "nothing written";
+      ok = false;
+    } else {
+      done += static_cast<size_t>(n);
+    }
+  }
+  if (ok && ::fsync(fd) != 0) {
+    error = std::string("fsync: ") + std::strerror(errno);
+    ok = false;
+  }
+  if (ok && (::fstat(fd, &st) != 0 || st.st_size != before + static_cast<off_t>(text.size()))) {
+    error = "the file did not grow by the rows written";
+    ok = false;
+  }
+  if (!ok) {
+    if (::ftruncate(fd, before) == 0 && before == 0 && fresh) ::unlink(options_.spool.c_str());
+  }
+  ::close(fd);
+  return ok;
+}
+
+bool ResultsStore::spill(std::vector<Row>& rows) {
+  if (rows.empty()) return true;
+  std::string error;
+  if (!append_to_spool(rows, error)) {
+    // No database and no disk: the rows stay in memory; the end says
+    // truthfully where each row is.
+    if (!spool_failing_)
+      std::fprintf(stderr, "rvc: cannot write the results spool %s: %s; keeping %zu rows in memory\n",
+                   options_.spool.c_str(), error.c_str(), rows.size());
+    spool_failing_ = true;
+    spool_error_ = error;
+    spool_retry_ = Clock::now() + std::chrono::seconds(1);
+    pending_.insert(pending_.end(), std::make_move_iterator(rows.begin()), std::make_move_iterator(rows.end()));
+    rows.clear();
+    return false;
+  }
+  if (spool_failing_)
+    std::fprintf(stderr, "rvc: the results spool %s takes rows again\n", options_.spool.c_str());
+  spool_failing_ = false;
+  spooling_ = true;
+  {
     std::lock_guard<std::mutex> lock(mutex_);
     stats_.spooled += rows.size();
   }
   rows.clear();
+  return true;
 }
 
 bool ResultsStore::drain_spool() {
@@ -300,7 +446,7 @@ bool ResultsStore::drain_spool() {
   uint64_t number = 0;
   while (std::getline(in, line)) {
     ++number;
-    if (line.empty()) continue;
+    if (line.empty() || (number == 1 && line == kSpoolHeader)) continue;
     Row r;
     if (!from_spool_line(line, r, error)) {
       std::fprintf(stderr, "rvc: results spool %s line %llu: %s (line skipped)\n", options_.spool.c_str(),
@@ -314,23 +460,40 @@ bool ResultsStore::drain_spool() {
   while (done < rows.size()) {
     const size_t n = std::min(kBatchRows, rows.size() - done);
     std::vector<Row> batch(std::make_move_iterator(rows.begin() + done), std::make_move_iterator(rows.begin() + done + n));
-    if (!write_batch(batch)) {
+    // A second stop signal while the run ends: the rest stays in the spool.
+    const bool cut = [this] {
+      std::lock_guard<std::mutex> lock(mutex_);
+      return stopping_;
+    }() && cut_wait();
+    if (cut || !write_batch(batch)) {
       // Keep what is not written yet, and only that: a later drain must not
       // write the committed batches twice.
       // (write_batch may have kept only the rows after a lost connection.)
       const size_t kept_from = done + n - batch.size();
       for (size_t i = 0; i < batch.size(); ++i) rows[kept_from + i] = std::move(batch[i]);
-      const std::string next = options_.spool + ".next";
-      {
-        std::ofstream out(next, std::ios::trunc);
-        for (size_t i = kept_from; i < rows.size(); ++i) out << to_spool_line(rows[i]) << '\n';
+      // A new file beside it (a name no one else has), synced, then renamed
+      // over it: a crash leaves the old or the new spool. If it cannot be
+      // written, the old spool stays whole (its written rows come again).
+      std::string next = options_.spool + ".XXXXXX";
+      const int fd = ::mkstemp(next.data());
+      if (fd < 0) return false;
+      std::string text = std::string(kSpoolHeader) + '\n';
+      for (size_t i = kept_from; i < rows.size(); ++i) text += to_spool_line(rows[i]) + '\n';
+      bool ok = true;
+      for (size_t off = 0; ok && off < text.size();) {
+        const ssize_t w = ::write(fd, text.data() + off, text.size() - off);
+        if (w < 0 && errno == EINTR) continue;
+        ok = w > 0;
+        if (ok) off += static_cast<size_t>(w);
       }
-      std::rename(next.c_str(), options_.spool.c_str());  // atomic: a crash leaves the old or the new spool
+      ok = ok && ::fchmod(fd, 0644) == 0 && ::fsync(fd) == 0;
+      ::close(fd);
+      if (!ok || std::rename(next.c_str(), options_.spool.c_str()) != 0) ::unlink(next.c_str());
       return false;
     }
     done += n;
   }
-  std::remove(options_.spool.c_str());
+  std::remove(options_.spool.c_str());  // rvc's own (it has the header, or this run wrote it)
   spooling_ = false;
   return true;
 }
@@ -356,13 +519,23 @@ void ResultsStore::writer_loop() {
       deadline = deadline_;
     }
     const auto now = Clock::now();
-    if (!connected_ && now >= next_attempt) {
+    if (stopping && cut_wait()) {
+      // A second stop signal: no more waiting for anything, everything kept
+      // goes behind the spool as it is.
+      std::vector<Row> all(std::make_move_iterator(pending_.begin()), std::make_move_iterator(pending_.end()));
+      pending_.clear();
+      all.insert(all.end(), std::make_move_iterator(batch.begin()), std::make_move_iterator(batch.end()));
+      batch.clear();
+      spill(all);
+      break;
+    }
+    const bool late = stopping && now >= deadline;
+    // Past the end's deadline no reconnection is tried (a host that does not
+    // answer would hold the end for its connect timeout).
+    if (!connected_ && !late && now >= next_attempt) {
       if (db_->reconnect()) {
         connected_ = true;
         backoff = options_.retry_interval;
-        std::fprintf(stderr, "rvc: results database %s is back: writing what was kept\n", description_.c_str());
-        std::lock_guard<std::mutex> lock(mutex_);
-        ++stats_.reconnects;
       } else {
         next_attempt = now + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(backoff));
         backoff = std::min(backoff * 2, 5.0);
@@ -377,13 +550,13 @@ void ResultsStore::writer_loop() {
     }
     if (connected_ && !spooling_ && pending_.empty()) {
       if (!write_batch(batch)) pending_.assign(std::make_move_iterator(batch.begin()), std::make_move_iterator(batch.end()));
-    } else if (spooling_) {
+    } else if (spooling_ && pending_.empty()) {
       spill(batch);  // behind what is already spooled
     } else {
       pending_.insert(pending_.end(), std::make_move_iterator(batch.begin()), std::make_move_iterator(batch.end()));
     }
     batch.clear();
-    if (pending_.size() > options_.memory_rows) {
+    if (pending_.size() > options_.memory_rows && (!spool_failing_ || Clock::now() >= spool_retry_)) {
       std::vector<Row> all(std::make_move_iterator(pending_.begin()), std::make_move_iterator(pending_.end()));
       pending_.clear();
       spill(all);
@@ -399,7 +572,7 @@ void ResultsStore::writer_loop() {
         flushed_ = true;
         break;
       }
-      if (empty && Clock::now() >= deadline) {
+      if (empty && late && !connected_) {
         std::vector<Row> all(std::make_move_iterator(pending_.begin()), std::make_move_iterator(pending_.end()));
         pending_.clear();
         spill(all);
@@ -418,18 +591,45 @@ bool ResultsStore::finish(double wait_seconds) {
   wake_.notify_one();
   if (writer_.joinable()) writer_.join();
   done_ = true;
-  if (flushed_) return true;
-  uint64_t left = 0;
-  std::ifstream in(options_.spool);
-  std::string line;
-  while (std::getline(in, line)) left += !line.empty();
-  left += pending_.size();
-  std::lock_guard<std::mutex> lock(mutex_);
-  stats_.left_in_spool = left;
-  std::fprintf(stderr,
-               "rvc: results database %s did not come back within %.1f s: %llu rows kept in %s (the next run with this "
-               "spool writes them)\n",
-               description_.c_str(), wait_seconds, static_cast<unsigned long long>(left), options_.spool.c_str());
+  if (!started_ || flushed_) return true;
+  // What the spool holds now (rows of earlier runs too), counted from the
+  // file itself: the claim below is what is there.
+  uint64_t kept = 0;
+  {
+    std::ifstream in(options_.spool);
+    std::string line;
+    for (uint64_t number = 1; std::getline(in, line); ++number)
+      kept += !line.empty() && !(number == 1 && line == kSpoolHeader);
+  }
+  const uint64_t lost = pending_.size();
+  if (kept == 0 && lost == 0) return true;
+  StoreStats s;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stats_.left_in_spool = kept;
+    stats_.lost = lost;
+    s = stats_;
+  }
+  const bool stopped = options_.stop_signals && options_.stop_signals() > 0;
+  char waited[96];
+  if (cut_wait())
+    std::snprintf(waited, sizeof waited, "was still being written when a second stop signal cut the wait");
+  else if (stopped)
+    std::snprintf(waited, sizeof waited, "is away and the run was stopped by a signal (no waiting)");
+  else
+    std::snprintf(waited, sizeof waited, "did not come back within %.1f s", wait_seconds);
+  if (kept)
+    std::fprintf(stderr, "rvc: results database %s %s: %llu rows kept in %s (the next run with this spool writes them)\n",
+                 description_.c_str(), waited, static_cast<unsigned long long>(kept), options_.spool.c_str());
+  if (lost)
+    std::fprintf(stderr,
+                 "rvc: results database %s %s, and the spool %s cannot be written (%s): %llu rows of results are "
+                 "lost\n",
+                 description_.c_str(), waited, options_.spool.c_str(), spool_error_.c_str(),
+                 static_cast<unsigned long long>(lost));
+  if (s.outages > kReportedOutages)
+    std::fprintf(stderr, "rvc: results database %s went away %llu times during the run\n", description_.c_str(),
+                 static_cast<unsigned long long>(s.outages));
   return false;
 }
 

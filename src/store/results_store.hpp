@@ -5,14 +5,17 @@
 // window, a ring of the last N input messages); a writer thread commits them
 // in batches, one transaction each, so the store keeps up with the engine.
 // When the database goes away, rows wait in memory and then in a spool file
-// (JSON lines) while the writer reconnects; nothing is dropped. At the end
-// the store waits for the database (wait_seconds); what still cannot be
+// (JSON lines after a {"rvc_spool":1} header) while the writer reconnects;
+// nothing is dropped. At the end the store waits for the database
+// (wait_seconds; not at all after a stop signal); what still cannot be
 // written stays in the spool, and the next run on the same spool writes it
-// first.
+// first. A spool write counts only once it is synced and its size checked:
+// rows the spool could not take are reported as lost, never as kept.
 #pragma once
 
 #include <chrono>
 #include <condition_variable>
+#include <functional>
 #include <cstdint>
 #include <deque>
 #include <memory>
@@ -36,6 +39,10 @@ struct StoreOptions {
   double flush_interval = 0.1;     // seconds between batches
   double retry_interval = 0.5;     // seconds between reconnection attempts (doubling up to 5 s)
   double wait_seconds = 10;        // at the end: how long to wait for an absent database
+  // How many stop signals (SIGINT/SIGTERM) arrived; null: none ever. After
+  // one, the end does not wait for an absent database (the rest is spooled at
+  // once); a second one cuts any wait left (a slow drain: the rest is spooled).
+  std::function<int()> stop_signals;
 };
 
 struct RunInfo {
@@ -53,18 +60,29 @@ struct StoreStats {
   uint64_t reconnects = 0;   // times the database came back
   uint64_t left_in_spool = 0;  // rows still in the spool at the end (database never came back)
   uint64_t refused = 0;      // rows the database refused as they are (reported one by one)
+  std::string first_refusal;  // why the first of them was refused
+  uint64_t lost = 0;         // rows neither in the database nor in the spool at the end (the spool failed)
+  uint64_t outages = 0;      // times the database went away
 };
+
+// The first line of every spool file rvc writes: a file without it is not
+// rvc's, and is never read, cut or deleted.
+inline constexpr const char* kSpoolHeader = "{\"rvc_spool\":1}";
 
 class ResultsStore {
  public:
   // `db` must already hold the schema. Rows left in the spool by an earlier
-  // run are written first.
+  // run are written first (from begin_run() on). Throws DbError (not a lost
+  // connection: a usage error) when the spool file exists and is not an rvc
+  // spool (no header, not a regular file, empty): it is left as it is.
   ResultsStore(std::unique_ptr<Database> db, StoreOptions options);
   ~ResultsStore();  // finishes (as end() without a run end) if end() was not called
   ResultsStore(const ResultsStore&) = delete;
   ResultsStore& operator=(const ResultsStore&) = delete;
 
   // Engine thread -----------------------------------------------------------
+  // Starts the writer. Throws DbError (a usage error) if the spool file is
+  // one of the run's inputs: rvc would read it as a spool, then delete it.
   void begin_run(const RunInfo& info);
   const std::string& run_id() const { return run_; }
   // An input message, before the engine sees it (the witness window).
@@ -96,8 +114,12 @@ class ResultsStore {
   void writer_loop();
   bool write_batch(std::vector<Row>& batch);  // writer thread; false: database away
   void write_one_by_one(std::vector<Row>& batch);  // after a refused batch: keep every row it can
-  void spill(std::vector<Row>& rows);          // to the spool file
+  bool spill(std::vector<Row>& rows);          // to the spool file; false: kept in pending_ (it failed)
+  bool append_to_spool(const std::vector<Row>& rows, std::string& error);  // synced and size-checked
   bool drain_spool();                          // spool -> database; false: database away
+  void went_away(const std::string& why);      // writer thread: the database is away (printed a few times)
+  void wrote();                                // writer thread: a write succeeded (back, if it was away)
+  bool cut_wait() const { return options_.stop_signals && options_.stop_signals() >= 2; }
   bool finish(double wait_seconds);
 
   std::unique_ptr<Database> db_;
@@ -125,7 +147,13 @@ class ResultsStore {
   std::deque<Row> pending_;  // failed to write, in order
   bool spooling_ = false;    // the spool file holds rows older than pending_/queue_
   bool connected_ = true;
+  bool away_ = false;        // the database went away and no write succeeded since
+  bool spool_failing_ = false;  // the last spool write failed (said once per streak)
+  std::chrono::steady_clock::time_point spool_retry_;  // no spool write before (while it fails)
+  std::string spool_error_;  // why the spool could not be written
+  bool started_ = false;     // begin_run() started the writer
   int spool_lock_ = -1;      // flock on "<spool>.lock": one process per spool file
+  bool lock_created_ = false;  // the .lock is rvc's: removed at the end
 };
 
 }  // namespace rvc::store

@@ -1,9 +1,25 @@
 // SQLite backend: the embedded default (`--output sqlite:results.db`).
 // WAL journal, so the dashboard (another process) reads while the monitor
 // writes; one prepared statement per table, one transaction per batch.
+//
+// rvc changes only its own databases: a file it creates is stamped with
+// PRAGMA application_id = kApplicationId in the transaction that creates its
+// tables; an existing file is used only if it has that stamp, or (made by an
+// rvc before the stamp) exactly rvc's tables. Anything else (another
+// application's database, an empty file, a file that is not SQLite) is
+// refused before a byte of it changes: no journal mode, no tables.
+#include <fcntl.h>
 #include <sqlite3.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
+#include <cerrno>
+#include <chrono>
+#include <cstdlib>
+#include <cstring>
 #include <map>
+#include <set>
+#include <thread>
 
 #include "store/database.hpp"
 #include "store/schema.hpp"
@@ -11,16 +27,37 @@
 namespace rvc::store {
 namespace {
 
+constexpr int kApplicationId = 0x72766331;  // "rvc1"
+
+// The tables of an rvc results database, as rvc before the stamp made them.
+const std::set<std::string>& rvc_tables() {
+  static const std::set<std::string> tables{"runs", "properties", "verdicts", "violations", "counters"};
+  return tables;
+}
+
 class SqliteDatabase final : public Database {
  public:
-  explicit SqliteDatabase(const std::string& path) : path_(path) {
-    if (sqlite3_open_v2(path.c_str(), &db_, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, nullptr) != SQLITE_OK) {
+  SqliteDatabase(const std::string& path, bool read_only) : path_(path), read_only_(read_only) {
+    bool created = false;
+    if (!read_only) created = create_if_missing();
+    const int flags = read_only ? SQLITE_OPEN_READONLY : SQLITE_OPEN_READWRITE;
+    if (sqlite3_open_v2(path.c_str(), &db_, flags, nullptr) != SQLITE_OK) {
       std::string what = db_ ? sqlite3_errmsg(db_) : "out of memory";
       sqlite3_close(db_);
       db_ = nullptr;
       throw DbError("cannot open " + describe() + ": " + what);
     }
     sqlite3_busy_timeout(db_, 5000);
+    if (created) {
+      // Stamp and tables in one transaction: the file is rvc's whole, or empty.
+      exec("BEGIN EXCLUSIVE");
+      exec("PRAGMA application_id=" + std::to_string(kApplicationId));
+      for (const auto& sql : schema_statements(Dialect::Sqlite)) exec(sql);
+      exec("COMMIT");
+    } else {
+      check_ours();
+    }
+    if (read_only) return;  // the dashboard changes nothing, not even the journal mode
     exec("PRAGMA journal_mode=WAL");
     exec("PRAGMA synchronous=NORMAL");  // WAL: durable at checkpoints, no fsync per batch
     exec("PRAGMA cache_size=-32768");   // 32 MiB: indexes of a long run stay in memory
@@ -32,6 +69,9 @@ class SqliteDatabase final : public Database {
   }
 
   void ensure_schema() override {
+    if (read_only_) return;
+    if (!stamped_) exec("PRAGMA application_id=" + std::to_string(kApplicationId));  // an older rvc's file
+    stamped_ = true;
     for (const auto& sql : schema_statements(Dialect::Sqlite)) exec(sql);
     for (const AddedColumn& c : added_columns())
       if (!has_column(c.table, c.column))
@@ -139,13 +179,63 @@ class SqliteDatabase final : public Database {
     return stmt;
   }
 
+  // True if this call made the (empty) file: it is rvc's to fill. A file
+  // that exists and is empty may be another rvc's, between its creation and
+  // its first commit (a moment): wait a little for its tables, then refuse.
+  bool create_if_missing() {
+    const int fd = ::open(path_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+    if (fd >= 0) {
+      ::close(fd);
+      return true;
+    }
+    if (errno != EEXIST) throw DbError("cannot create " + describe() + ": " + std::strerror(errno));
+    struct stat st {};
+    for (int i = 0; i < 100 && ::stat(path_.c_str(), &st) == 0 && st.st_size == 0; ++i)
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    return false;
+  }
+
+  // An existing file: rvc's (stamped, or an older rvc's table set), or refused
+  // as it is.
+  void check_ours() {
+    struct stat st {};
+    if (::stat(path_.c_str(), &st) == 0 && st.st_size == 0)
+      throw DbError(describe() + " is an empty file that rvc did not create: refusing to turn it into a results "
+                    "database (remove it, or name a new file)");
+    QueryResult id, tables;
+    try {
+      id = query("PRAGMA application_id", {});
+      tables = query("SELECT name FROM sqlite_master WHERE type = 'table' AND name NOT LIKE 'sqlite_%'", {});
+    } catch (const DbError&) {
+      throw DbError(describe() + " is not a results database rvc can read (" + sqlite3_errmsg(db_) + ")");
+    }
+    const long long app = id.empty() ? 0 : std::atoll(id[0][0].c_str());
+    if (app == kApplicationId) {
+      stamped_ = true;
+      return;
+    }
+    std::set<std::string> names;
+    for (const auto& row : tables) names.insert(row[0]);
+    if (app == 0 && names == rvc_tables()) return;  // made by an rvc before the stamp
+    std::string listed;
+    for (const auto& name : names) listed += (listed.empty() ? "" : ", ") + name;
+    throw DbError(describe() + " is not an rvc results database (" +
+                  (app ? "application_id " + std::to_string(app) + ", " : std::string()) +
+                  (names.empty() ? std::string("no tables") : "tables: " + listed) +
+                  "): refusing to change it (name a new file for rvc's results)");
+  }
+
   std::string path_;
+  bool read_only_ = false;
+  bool stamped_ = false;  // application_id is rvc's
   sqlite3* db_ = nullptr;
   std::map<Table, sqlite3_stmt*> inserts_;
 };
 
 }  // namespace
 
-std::unique_ptr<Database> open_sqlite(const std::string& path) { return std::make_unique<SqliteDatabase>(path); }
+std::unique_ptr<Database> open_sqlite(const std::string& path, bool read_only) {
+  return std::make_unique<SqliteDatabase>(path, read_only);
+}
 
 }  // namespace rvc::store

@@ -25,16 +25,20 @@ struct FlakyDb : Database {
     std::vector<Row> rows;
     std::atomic<bool> down{false};
     std::atomic<int> failed_writes{0};
+    std::atomic<int> write_ms{0};  // a slow database: each write takes this long
+    std::atomic<int> writes{0};    // writes begun
   };
   explicit FlakyDb(std::shared_ptr<Shared> s) : s(std::move(s)) {}
   void ensure_schema() override {}
   void write(const std::vector<Row>& rows) override {
+    ++s->writes;
     if (s->down) {
       ++s->failed_writes;
       throw DbError("server closed the connection", true);
     }
     for (const Row& r : rows)
       if (r.text[0] == "refused") throw DbError("invalid input syntax", false);  // the whole batch rolls back
+    if (s->write_ms) std::this_thread::sleep_for(std::chrono::milliseconds(s->write_ms.load()));
     std::lock_guard<std::mutex> lock(s->mutex);
     s->rows.insert(s->rows.end(), rows.begin(), rows.end());
   }
@@ -163,6 +167,53 @@ TEST(ResultsStore, TheSpoolOutlivesTheRun) {
   EXPECT_EQ(shared->rows[0].text[0], "first");
   EXPECT_EQ(shared->rows[5].text[0], "second");
   EXPECT_FALSE(std::filesystem::exists(spool));
+}
+
+// A second stop signal cuts the drain of a long spool into a slow database:
+// the end returns at the next batch instead of after all of them, and every
+// row is in the database or still in the spool, none in both.
+TEST(ResultsStore, ASecondStopSignalCutsTheDrain) {
+  const std::string spool = temp_path("g.spool");
+  auto shared = std::make_shared<FlakyDb::Shared>();
+  shared->down = true;
+  StoreOptions o = fast_options(spool);
+  o.wait_seconds = 0.05;
+  o.memory_rows = 1000;
+  constexpr int kVerdicts = 50000;  // five batches of the drain
+  {
+    ResultsStore first(std::make_unique<FlakyDb>(shared), o);
+    first.begin_run({"first", {"in"}, "discrete", {{"p1", "{a}"}}});
+    for (int i = 0; i < kVerdicts; ++i) first.on_verdict("p1", i, true), first.on_verdict("p1", i, i % 2 == 0);
+    EXPECT_FALSE(first.end_run(0, "eos", "{}"));
+  }
+  const uint64_t spooled = [&] {
+    std::ifstream in(spool);
+    std::string line;
+    uint64_t n = 0;
+    while (std::getline(in, line)) ++n;
+    return n - 1;  // the header
+  }();
+  ASSERT_GT(spooled, 40000u);
+  shared->down = false;
+  shared->write_ms = 300;
+  std::atomic<int> signals{0};
+  o.stop_signals = [&] { return signals.load(); };
+  ResultsStore second(std::make_unique<FlakyDb>(shared), o);
+  const int writes_before = shared->writes;
+  second.begin_run({"second", {"in"}, "discrete", {}});  // the drain starts
+  for (int i = 0; i < 1000 && shared->writes == writes_before; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  ASSERT_GT(shared->writes, writes_before);  // its first batch is being written
+  signals = 2;  // `docker stop`, then again
+  EXPECT_FALSE(second.end_run(0, "signal", "{}"));
+  const StoreStats s = second.stats();
+  // At most the batch being written when the signal came went in; without
+  // the cut all eight would have (taking 2.4 s), leaving only this run's rows.
+  EXPECT_GE(s.left_in_spool + 10000, spooled + 2);
+  // Nothing lost, nothing twice: the database holds the spool's first rows,
+  // the spool the rest and this run's three (run, its end).
+  EXPECT_EQ(shared->rows.size() + s.left_in_spool, spooled + 2);
+  EXPECT_EQ(s.lost, 0u);
 }
 
 // A row the database refuses as it is costs only itself: the rest of its

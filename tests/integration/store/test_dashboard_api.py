@@ -182,6 +182,10 @@ class Events:
         return None
 
     def close(self):
+        # The server closes every connection after its response ("Connection: close"), so
+        # http.client hands the socket to the response: closing the connection alone would
+        # leave it open.
+        self.resp.close()
         self.conn.close()
 
 
@@ -499,6 +503,30 @@ def test_explanations_kept_and_an_older_database_gains_their_column(tmp_path):
         assert d.stop() == 0
 
 
+def test_an_older_database_is_served_as_it_is(tmp_path):
+    """A database from before explanations (violations without the column) is read, not migrated:
+    the dashboard opens it read-only, its violations have null explanations, and its bytes stay."""
+    import hashlib
+    db = tmp_path / "old.db"
+    with sqlite3.connect(db) as c:
+        for sql in SCHEMA:
+            c.execute(sql.replace(", explanation TEXT)", ")"))
+        c.execute("INSERT INTO runs (run, command, started_at) VALUES ('r1', 'rvc check', 1)")
+        c.execute("INSERT INTO violations (run, property, time, wall, witness) VALUES ('r1', 'p1', 3, 4, '[]')")
+    before = hashlib.sha256(db.read_bytes()).hexdigest()
+    d = Dashboard(f"sqlite:{db}")
+    try:
+        status, body = d.get("/api/runs/r1/violations")
+        assert status == 200 and [(v["time"], v["explanation"]) for v in body["violations"]] == [(3, None)]
+        ev = Events(d.port, "/api/events?run=r1&verdict=0&violation=0&counters=0")
+        event = ev.next(timeout=5)
+        assert event is not None and event[0] == "violation" and event[1][0]["explanation"] is None
+        ev.close()
+    finally:
+        assert d.stop() == 0
+    assert hashlib.sha256(db.read_bytes()).hexdigest() == before
+
+
 # --- the same API over PostgreSQL ------------------------------------------------------------------
 
 def test_postgresql_database(rvc_pg, pg, tmp_path):
@@ -536,3 +564,67 @@ def test_postgresql_database(rvc_pg, pg, tmp_path):
         ev.close()
     finally:
         assert d.stop() == 0
+
+
+# --- under load: slow clients and too many event streams leave the API answerable ----------------
+
+def test_api_answers_with_slow_clients_and_streams_over_the_cap(dash):
+    """20 clients that send a byte of their request every 3 s, the 8 event streams allowed, and 100
+    more that must each get a 503 and a closed connection: /api/health still answers. (Without read
+    timeouts the slow clients hold server threads for as long as they trickle; the 503s, left open
+    by keep-alive, held one more each.) Every socket here is to 127.0.0.1 and has a timeout."""
+    import socket
+
+    stop = threading.Event()
+    closed_by_server = []
+
+    def slow_client():
+        s = socket.create_connection(("127.0.0.1", dash.port), timeout=30)
+        try:
+            for byte in b"GET /api/health HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n":
+                s.sendall(bytes([byte]))
+                if stop.wait(3):
+                    return
+                s.settimeout(0.01)
+                try:
+                    if s.recv(1024) == b"":  # the server gave up on us
+                        closed_by_server.append(True)
+                        return
+                except (socket.timeout, BlockingIOError):
+                    pass
+                except OSError:
+                    closed_by_server.append(True)
+                    return
+        except OSError:
+            closed_by_server.append(True)
+        finally:
+            s.close()
+
+    slow = [threading.Thread(target=slow_client, daemon=True) for _ in range(20)]
+    for t in slow:
+        t.start()
+    streams = [Events(dash.port, "/api/events?run=r-live") for _ in range(8)]
+    try:
+        assert all(s.resp.status == 200 for s in streams)
+        for _ in range(100):
+            s = socket.create_connection(("127.0.0.1", dash.port), timeout=15)
+            s.sendall(b"GET /api/events?run=r-live HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n")
+            got = b""
+            while True:  # to the end: the server closes the connection after its 503
+                chunk = s.recv(65536)
+                if not chunk:
+                    break
+                got += chunk
+            s.close()
+            assert got.startswith(b"HTTP/1.1 503") and b"too many event streams" in got, got[:200]
+        status, body = dash.get("/api/health")  # 10 s socket timeout: liveness, not speed
+        assert status == 200 and body["ok"] is True
+        for t in slow:  # each notices the server's close at its next byte, 3 s on
+            t.join(timeout=20)
+    finally:
+        stop.set()
+        for s in streams:
+            s.close()
+        for t in slow:
+            t.join(timeout=30)
+    assert len(closed_by_server) == 20  # every slow client was cut off by the server's read timeout

@@ -10,6 +10,7 @@ Test A spells the expected rows out by hand; the longer traces of B and C use
 """
 import json
 import os
+import signal
 import sqlite3
 import subprocess
 import threading
@@ -207,11 +208,58 @@ def test_b_outage_in_the_middle(rvc_pg, pg, tmp_path):
 
 
 # ---------------------------------------------------------------------------
+# D: `docker stop` while the server is away: SIGTERM spools at once instead of
+# waiting --db-wait (docker would SIGKILL after its 10 s grace), and the next
+# run writes the spool.
+
+def test_d_signal_while_the_server_is_away_spools_at_once(rvc_pg, pg, tmp_path):
+    values = [i != 12 for i in range(20)]  # violated at 12, while the server is away
+    spool = tmp_path / "d.spool"
+    proc = subprocess.Popen([rvc_pg, "check", "-p", props_file(tmp_path), "-", "--output", pg.uri,
+                             "--db-wait", "600", "--spool", str(spool)],
+                            stdin=subprocess.PIPE, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    try:
+        err = Stderr(proc)
+        proc.stdin.write("".join(line(i, values[i]) + "\n" for i in range(10)))
+        proc.stdin.flush()
+        wait_until(lambda: rows_in(pg, "verdicts") == 2, 10, "the first verdicts")
+        pg.stop()
+        proc.stdin.write("".join(line(i, values[i]) + "\n" for i in range(10, 20)))
+        proc.stdin.flush()
+        err.wait_for("keeping results and retrying", 10)
+        proc.send_signal(signal.SIGTERM)  # stdin stays open: only the signal ends the run
+        # Liveness only: waiting out --db-wait (600 s) would not end within this.
+        assert proc.wait(timeout=60) == 1, err.text()  # violated
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    assert "stopped by a signal (no waiting)" in err.text(), err.text()
+    tables = spooled_tables(spool)
+    # Hand-counted, while away: `now` false at 12 and true at 13, `always` false at 12; two violations.
+    assert tables == ["verdict", "violation", "verdict", "violation", "verdict", "run_end"], tables
+
+    pg.start()
+    trace = tmp_path / "d2.jsonl"
+    trace.write_text(line(0, True) + "\n")
+    second = subprocess.run([rvc_pg, "check", "-p", props_file(tmp_path), str(trace), "--output", pg.uri,
+                             "--spool", str(spool)], capture_output=True, text=True, timeout=60)
+    assert second.returncode == 0, second.stderr
+    assert not spool.exists()
+    first = pg.sql("SELECT run, exit_status, end_reason FROM runs ORDER BY started_at")[0]
+    assert (first["exit_status"], first["end_reason"]) == (1, "signal")
+    want_verdicts, want_violations = expected(values, "-")
+    assert stored(pg, first["run"]) == (want_verdicts, want_violations)
+
+
+# ---------------------------------------------------------------------------
 # C: the database is away until the run ends: the rows wait in the spool,
 # and the next run on that spool writes them (once).
 
 def spooled_tables(spool):
-    return [json.loads(l)["table"] for l in spool.read_text().splitlines() if l.strip()]
+    lines = [l for l in spool.read_text().splitlines() if l.strip()]
+    assert lines[0] == '{"rvc_spool":1}', lines[:1]  # rvc's own spool: its header first
+    return [json.loads(l)["table"] for l in lines[1:]]
 
 
 @pytest.mark.parametrize("away", ["from_the_start", "after_the_start"])
