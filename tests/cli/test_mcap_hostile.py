@@ -331,3 +331,36 @@ def test_samples_rvc_cannot_read_say_what_they_are(mcap_rvc, tmp_path):
            "compression;" in r.stderr, r.stderr
     assert "message 3: bad test_msgs/msg/Outer sample: string field 'inner.label' claims 7 bytes, the sample has " \
            "3 left at byte 4" in r.stderr, r.stderr
+
+
+def test_a_chunk_over_the_limit_is_skipped_before_it_is_decompressed(mcap_rvc, tmp_path):
+    """A zstd chunk of 300 MiB of zeros (about 10 KiB compressed: its frames can hold it) is over
+    rvc's limit for one chunk (256 MiB, docs/ros2-types.md): skipped, named, nothing allocated for it;
+    the chunks after it are checked."""
+    import zlib
+    import zstandard
+    size = 300 << 20
+    payload_len = size - 9 - 22
+    head = bytes([OP_MESSAGE]) + struct.pack("<Q", 22 + payload_len) + struct.pack("<HIQQ", 1, 0, 0, 0)
+    crc, comp = zlib.crc32(head), zstandard.ZstdCompressor().compressobj(size=size)
+    parts = [comp.compress(head)]
+    zeros = bytes(1 << 20)
+    for k in range(0, payload_len, len(zeros)):
+        block = zeros[: min(len(zeros), payload_len - k)]
+        crc = zlib.crc32(block, crc)
+        parts.append(comp.compress(block))
+    parts.append(comp.flush())
+    data_z = b"".join(parts)
+    chunk = record(OP_CHUNK, struct.pack("<QQQI", 0, 0, size, crc) + string(b"zstd")
+                   + struct.pack("<Q", len(data_z)) + data_z)
+    rows = [{"p": i != 150} for i in range(200)]
+    data = open(json_bag(tmp_path / "z.mcap", rows, compression="zstd"), "rb").read()
+    chunks = [(pos, body, n) for pos, op, body, n in records(data) if op == OP_CHUNK]
+    pos, body, n = chunks[1]
+    bag = tmp_path / "big.mcap"
+    bag.write_bytes(data[:pos] + chunk + data[body + n:])
+    rc, out, err, rss_kib = run_measured([mcap_rvc, "check", "--all", "--spec", "{p}", str(bag)])
+    assert rc == 1, err
+    assert f"the chunk at offset {pos}: it claims {size} bytes uncompressed, over rvc's limit of 256 MiB for " \
+           "one chunk; its records are skipped" in err, err
+    assert rss_kib < 200 * 1024, rss_kib
