@@ -55,7 +55,9 @@ for name in "${harnesses[@]}"; do
   cp "$seeds"/* "$work/corpus/"
   echo "== fuzz_$name: ${seconds} s from $(ls "$seeds" | wc -l) seeds"
   rc=0
-  "$bin" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=4096 -print_final_stats=1 \
+  # A harness's own libFuzzer flags, if it has some (fuzz_mcap: a malloc limit).
+  read -r -a flags < <(cat "tests/fuzz/fuzz_$name.flags" 2>/dev/null || true) || true
+  "$bin" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=4096 -print_final_stats=1 "${flags[@]}" \
     -artifact_prefix="$work/art/" "$work/corpus" >"$work/log" 2>&1 || rc=$?
   grep -E '^stat::(number_of_executed_units|peak_rss_mb|new_units_added)' "$work/log" | tr '\n' ' ' || true
   echo

@@ -16,8 +16,10 @@ BagRun run_bag(const std::string& path, const std::vector<std::string>& topics,
     run.topic = bag.topic;
     run.description = "topic " + bag.topic + " (" + (bag.type ? bag.type->full_name() : std::string("JSON")) + ", " +
                       std::to_string(bag.messages) + " messages)";
-    run.outcome = runtime::check_bag({bag}, pipeline, outputs);
+    uint64_t skipped = 0;
+    run.outcome = runtime::check_bag({bag}, pipeline, outputs, skipped);
     run.stats = pipeline.stats();
+    run.stats.rejected += skipped;  // the bag's bad records: rejected input like a malformed message
     run.violations = pipeline.violations();
     return run;
   }
@@ -33,8 +35,10 @@ BagRun run_bag(const std::string& path, const std::vector<std::string>& topics,
                        std::to_string(bags[i].messages) + ")";
   }
   run.description += std::string(", sync ") + sync::to_string(sync.options(inputs).policy);
-  run.outcome = runtime::check_bag(bags, pipeline, outputs);
+  uint64_t skipped = 0;
+  run.outcome = runtime::check_bag(bags, pipeline, outputs, skipped);
   run.stats = pipeline.stats();
+  run.stats.rejected += skipped;
   run.violations = pipeline.violations();
   return run;
 }

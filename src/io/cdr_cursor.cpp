@@ -8,6 +8,12 @@ bool CdrCursor::open(std::string_view sample) {
     return false;
   }
   const auto b0 = static_cast<unsigned char>(sample[0]), b1 = static_cast<unsigned char>(sample[1]);
+  if (sample.compare(0, 4, "\x28\xb5\x2f\xfd") == 0) {  // zstd's frame magic, where CDR's header would be
+    error_ = {"this message is zstd-compressed (rosbag2 per-message compression; rvc reads uncompressed "
+              "samples: write the bag again without compression, e.g. with ros2 bag convert)",
+              0};
+    return false;
+  }
   if (b0 != 0 || b1 > 1) {
     const char* what = b0 == 0 && (b1 == 2 || b1 == 3)   ? " (parameter-list CDR)"
                        : b0 == 0 && b1 >= 6 && b1 <= 11 ? " (XCDR2, not ROS 2's plain CDR)"
@@ -25,6 +31,14 @@ bool CdrCursor::open(std::string_view sample) {
   depth_ = 0;
   swap_ = (b1 == 1) != host_little;
   return true;
+}
+
+bool CdrCursor::string_too_long(uint32_t len) {
+  const std::string p = path();
+  error_ = {(p.empty() ? std::string("a string") : "string field '" + p + "'") + " claims " + std::to_string(len) +
+                " bytes, the sample has " + std::to_string(size_ - pos_ - 4) + " left",
+            pos_ + kHeader};
+  return false;
 }
 
 std::string CdrCursor::path() const {

@@ -94,7 +94,11 @@ class CdrCursor {
   }
   bool string(std::string_view& text, uint32_t bound) {
     uint32_t len = 0;
-    if (!count(len, 1)) return false;
+    if (!read(len)) return false;
+    if (len > size_ - pos_) {  // a cut sample: say which string and by how much
+      pos_ -= 4;
+      return string_too_long(len);
+    }
     if (len == 0) {  // some writers send an empty string as length 0, without the NUL
       text = {};
       return true;
@@ -157,6 +161,7 @@ class CdrCursor {
     ++depth_;
   }
   std::string path() const;
+  bool string_too_long(uint32_t len);
 
   const unsigned char* data_ = nullptr;
   size_t size_ = 0;

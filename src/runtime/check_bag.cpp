@@ -26,7 +26,9 @@ BagInput select_bag_topic(const std::string& path, const std::string& topic, msg
   const transport::BagContents contents = transport::bag_topics(path);
   const auto& topics = contents.topics;
   if (topics.empty())
-    throw std::invalid_argument(contents.broken.empty() ? "bag '" + path + "' holds no messages" : contents.broken);
+    throw std::invalid_argument(!contents.broken.empty()          ? contents.broken
+                                : !contents.first_skipped.empty() ? contents.first_skipped
+                                                                  : "bag '" + path + "' holds no messages");
   BagInput in;
   in.path = path;
   if (topic.empty()) {
@@ -56,9 +58,15 @@ BagInput select_bag_topic(const std::string& path, const std::string& topic, msg
   return in;
 }
 
-Outcome check_bag(const std::vector<BagInput>& inputs, Feed& feed, VerdictOutputs& outputs) {
+Outcome check_bag(const std::vector<BagInput>& inputs, Feed& feed, VerdictOutputs& outputs, uint64_t& skipped) {
+  skipped = 0;
   return run_check(feed, outputs, [&](Outcome& outcome) {
     transport::McapBag bag(inputs.at(0).path);
+    constexpr uint64_t kShown = 100;  // as the pipeline's errors: a bag of bad records does not flood stderr
+    bag.on_skip([&](const std::string& reason) {
+      if (skipped++ < kShown) std::fprintf(stderr, "rvc: bag '%s': %s\n", bag.path().c_str(), reason.c_str());
+      outcome.rejected = true;
+    });
     transport::McapMessage m;
     for (;;) {
       try {
@@ -73,6 +81,9 @@ Outcome check_bag(const std::vector<BagInput>& inputs, Feed& feed, VerdictOutput
       for (size_t i = 0; i < inputs.size(); ++i)
         if (m.topic == inputs[i].topic) feed.feed_logged(static_cast<uint32_t>(i), m.data, m.index, m.log_time * 1e-9);
     }
+    if (skipped > kShown)
+      std::fprintf(stderr, "rvc: bag '%s': %llu more bad records were skipped and not shown\n", bag.path().c_str(),
+                   static_cast<unsigned long long>(skipped - kShown));
   });
 }
 

@@ -34,7 +34,12 @@ BagInput select_bag_topic(const std::string& path, const std::string& topic, msg
 // messages' 1-based indexes in the bag, over all topics). One topic: a
 // Pipeline; several: a SyncedPipeline. Like check_stream, never throws for a
 // failure while running: the outcome says so.
-Outcome check_bag(const std::vector<BagInput>& inputs, Feed& feed, VerdictOutputs& outputs);
+//
+// A bad record of the bag (a chunk whose CRC does not match, a message on a
+// channel never defined, ...) is reported with its offset, skipped and
+// counted in `skipped` (the run's rejected input: exit 3 unless a property
+// is violated); the messages around it are still checked.
+Outcome check_bag(const std::vector<BagInput>& inputs, Feed& feed, VerdictOutputs& outputs, uint64_t& skipped);
 
 // Several topics of a bag: "NAME=TOPIC" or "TOPIC" (named by its last part,
 // "/vehicle/status/gear_status" -> gear_status). The inputs to synchronize,

@@ -225,7 +225,7 @@ def test_truncated_and_corrupted_samples_are_rejected_with_an_offset(rvc):
     assert r.returncode == 3
     assert r.stdout == '{"data":"hello"}\n'
     err = r.stderr
-    assert "line 1: sequence length 1000 exceeds the sample in field data at byte 4" in err, err
+    assert "line 1: string field 'data' claims 1000 bytes, the sample has 6 left at byte 4" in err, err
     assert "line 2: string without its terminating NUL in field data" in err, err
     assert "line 3: 8 bytes left over after the last field" in err, err
     bname = "std_msgs/msg/Bool"

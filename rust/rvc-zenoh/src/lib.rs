@@ -30,7 +30,9 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Condvar, Mutex, RwLock};
 use std::time::{Duration, Instant};
 
+mod mcap_chunk;
 mod mcap_reader;
+mod mcap_records;
 
 use zenoh::bytes::ZBytes;
 use zenoh::key_expr::KeyExpr;

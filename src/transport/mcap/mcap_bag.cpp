@@ -2,6 +2,7 @@
 
 #include <cstring>
 #include <fstream>
+#include <vector>
 
 extern "C" const char* rvc_zenoh_last_error(void);
 
@@ -15,7 +16,9 @@ McapBag::~McapBag() { rvc_mcap_close(reader_); }
 
 bool McapBag::next(McapMessage& m) {
   rvc_mcap_message raw{};
-  const int rc = rvc_mcap_next(reader_, &raw);
+  int rc;
+  while ((rc = rvc_mcap_next(reader_, &raw)) == RVC_MCAP_SKIPPED)
+    if (on_skip_) on_skip_(rvc_zenoh_last_error());
   if (rc < 0) throw McapError("bag '" + path_ + "': " + rvc_zenoh_last_error());
   if (rc == 0) return false;
   auto text = [](const char* s) { return std::string_view(s, std::strlen(s)); };
@@ -27,6 +30,7 @@ bool McapBag::next(McapMessage& m) {
   m.data = std::string_view(reinterpret_cast<const char*>(raw.data), raw.len);
   m.log_time = raw.log_time;
   m.index = raw.index;
+  m.channel_id = raw.channel_id;
   return true;
 }
 
@@ -41,7 +45,13 @@ BagContents bag_topics(const std::string& path) {
   BagContents contents;
   auto& topics = contents.topics;
   McapBag bag(path);
+  bag.on_skip([&](const std::string& reason) {
+    if (contents.first_skipped.empty()) contents.first_skipped = "bag '" + path + "': " + reason;
+  });
   McapMessage m;
+  // Each channel's topic, found once: a bag of many channels costs no more
+  // per message than a bag of one.
+  std::vector<BagTopic*> by_channel(65536, nullptr);
   for (;;) {
     try {
       if (!bag.next(m)) break;
@@ -49,7 +59,9 @@ BagContents bag_topics(const std::string& path) {
       contents.broken = e.what();
       break;
     }
-    BagTopic& t = topics[std::string(m.topic)];
+    BagTopic*& slot = by_channel[m.channel_id];
+    if (!slot) slot = &topics[std::string(m.topic)];
+    BagTopic& t = *slot;
     if (t.messages++ == 0) {
       t.message_encoding = m.message_encoding;
       t.schema_name = m.schema_name;

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <stdexcept>
 #include <string>
@@ -22,8 +23,9 @@ class McapError : public std::invalid_argument {
 
 struct McapMessage {
   std::string_view topic, message_encoding, schema_name, schema_encoding, schema, data;
-  uint64_t log_time = 0;  // ns
-  uint64_t index = 0;     // 1-based over all topics
+  uint64_t log_time = 0;   // ns
+  uint64_t index = 0;      // 1-based over all topics
+  uint16_t channel_id = 0;
 };
 
 class McapBag {
@@ -33,8 +35,13 @@ class McapBag {
   McapBag(const McapBag&) = delete;
   McapBag& operator=(const McapBag&) = delete;
 
-  // False at the end; throws McapError for a broken record.
+  // False at the end; throws McapError when reading cannot go on (a record
+  // whose length runs past the file: a recording cut short). A record that
+  // is bad on its own (a chunk whose CRC does not match, a message on a
+  // channel never defined) is skipped: `on_skip` gets the reason ("the chunk
+  // at offset 4242: ...") and reading goes on.
   bool next(McapMessage& m);
+  void on_skip(std::function<void(const std::string&)> f) { on_skip_ = std::move(f); }
   const std::string& path() const { return path_; }
 
   // Whether the file starts with MCAP's magic bytes.
@@ -43,6 +50,7 @@ class McapBag {
  private:
   std::string path_;
   rvc_mcap_reader* reader_ = nullptr;
+  std::function<void(const std::string&)> on_skip_;
 };
 
 // One topic of a bag: its message count and channel (from its first message).
@@ -53,10 +61,12 @@ struct BagTopic {
 
 // Reads the whole bag once: every topic with its count and schema. A bag
 // broken part-way (a recording cut short) gives the topics before the break
-// and the reason in `broken`.
+// and the reason in `broken`; records skipped on the way are left for the
+// run that checks the bag to report.
 struct BagContents {
   std::map<std::string, BagTopic> topics;
   std::string broken;
+  std::string first_skipped;  // why the first record skipped was, if any
 };
 BagContents bag_topics(const std::string& path);
 

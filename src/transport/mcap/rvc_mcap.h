@@ -15,7 +15,8 @@
 extern "C" {
 #endif
 
-#define RVC_MCAP_EFORMAT (-4) /* not an MCAP file, or a broken record */
+#define RVC_MCAP_EFORMAT (-4) /* not an MCAP file, or a record whose length runs past the file */
+#define RVC_MCAP_SKIPPED 2    /* a bad record was skipped (reason in rvc_zenoh_last_error()): call again */
 
 typedef struct rvc_mcap_reader rvc_mcap_reader;
 
@@ -39,7 +40,10 @@ typedef struct rvc_mcap_message {
 
 /* Opens (memory-maps) the file and checks its magic. */
 int rvc_mcap_open(const char* path, rvc_mcap_reader** out);
-/* 1: *out holds the next message in file order; 0: end of file; < 0: error. */
+/* 1: *out holds the next message in file order; 0: end of file;
+ * RVC_MCAP_SKIPPED: a record was skipped (a chunk whose CRC does not match,
+ * a message on a channel never defined, ...), reading goes on at the next
+ * call; < 0: reading cannot go on. */
 int rvc_mcap_next(rvc_mcap_reader* reader, rvc_mcap_message* out);
 void rvc_mcap_close(rvc_mcap_reader* reader);
 
