@@ -19,6 +19,7 @@ BagRun run_bag(const std::string& path, const std::vector<std::string>& topics,
     run.outcome = runtime::check_bag({bag}, pipeline, outputs);
     run.stats = pipeline.stats();
     run.violations = pipeline.violations();
+    run.received = pipeline.received();
     return run;
   }
   std::vector<runtime::BagInput> bags;
@@ -36,6 +37,8 @@ BagRun run_bag(const std::string& path, const std::vector<std::string>& topics,
   run.outcome = runtime::check_bag(bags, pipeline, outputs);
   run.stats = pipeline.stats();
   run.violations = pipeline.violations();
+  run.received = pipeline.received();
+  pipeline.add_dropped(run.dropped);
   return run;
 }
 

@@ -80,9 +80,19 @@ struct PolicyOptions {
   // approximate: per input, the least time between two of its messages
   // (seconds; empty or 0: unknown). Lets a set out sooner.
   std::vector<double> inter_message_lower_bound;
-  // merge: a message is released once a message stamped more than max_delay
-  // after it has arrived (or by advance()/finish()).
+  // merge: a message is released once a message stamped more than the delay
+  // after it has arrived (or by advance()/finish()). The delay starts at
+  // max_delay; with adaptive_limit > 0 it grows to twice the largest lateness
+  // seen (how far behind the newest stamp a message arrived), at most to
+  // adaptive_limit: ordinary jitter stops making messages late after the
+  // first, and each further late message at least doubles the delay.
   double max_delay = 0;
+  double adaptive_limit = 0;
+  // merge: a late message (at or before the last set out) is not dropped but
+  // released as a set of its own, stamped just after that set (the least
+  // double above it): checked as the next event, since the events after its
+  // own stamp have been checked already.
+  bool process_late = false;
   // latest: the input whose messages make sets; -1: the fastest so far
   // (smallest mean interval between its stamps; ties: the lower input).
   int pivot = -1;
