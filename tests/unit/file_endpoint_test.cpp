@@ -92,15 +92,19 @@ TEST(FileSource, PullGivesTheSameFramesOnTheCallersThread) {
   Frame f;
   ASSERT_TRUE(p.source().pullable());
   EXPECT_EQ(p.source().pull(f), PullResult::Wait);  // nothing written yet
-  p.write("{\"a\":1}\r\n\n");
-  p.write(long_line.substr(0, 70000));
-  p.write(long_line.substr(70000) + "\n{\"a\":2}");
-  p.close_writer();
+  // Written by another thread: the pipe holds less than the long line.
+  std::thread writer([&] {
+    p.write("{\"a\":1}\r\n\n");
+    p.write(long_line.substr(0, 70000));
+    p.write(long_line.substr(70000) + "\n{\"a\":2}");
+    p.close_writer();
+  });
   for (int i = 0; i < 1000; ++i) {
     const PullResult r = p.source().pull(f);
     if (r == PullResult::End) break;
     if (r == PullResult::Frame) frames.emplace_back(f.seq, f.eos ? std::string("<eos>") : std::string(f.payload));
   }
+  writer.join();
   EXPECT_EQ(frames, (std::vector<F>{{1, "{\"a\":1}"}, {3, long_line}, {4, "{\"a\":2}"}, {4, "<eos>"}}));
   EXPECT_EQ(p.source().pull(f), PullResult::End);
 }

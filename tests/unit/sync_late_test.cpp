@@ -38,11 +38,11 @@ sync::PolicyOptions merge(double max_delay, double adaptive_limit, bool process_
   return o;
 }
 
-// a at 1, 3 (1 goes), b at 2 (late: 1 gone, lateness 1), a at 5, 6, b at 4.5.
+// a at 1, 3 (1 goes), b at 0.5 (late: 1 is gone; 2.5 behind the newest), a at 5, 6, b at 4.5.
 void feed_jittery(sync::Policy& p) {
   p.add({0, 1, 1});
   p.add({0, 3, 2});
-  p.add({1, 2, 3});
+  p.add({1, 0.5, 3});
   p.add({0, 5, 4});
   p.add({0, 6, 5});
   p.add({1, 4.5, 6});
@@ -53,7 +53,7 @@ TEST(MergeLate, FixedDelayDropsEveryLateMessage) {
   Sets rec;
   sync::StampMerge p(merge(0, 0), rec);
   feed_jittery(p);
-  // 1 out at a@3; b@2 late; 3 out at a@5, 5 at a@6; b@4.5 late.
+  // 1 out at a@3; b@0.5 late; 3 out at a@5, 5 at a@6; b@4.5 late.
   EXPECT_EQ(rec.late(), 2u);
   EXPECT_EQ(rec.released.at(3).first, sync::Release::Late);
   EXPECT_EQ(rec.released.at(6).first, sync::Release::Late);
@@ -63,8 +63,8 @@ TEST(MergeLate, AdaptiveDelayLearnsFromTheFirstLateMessage) {
   Sets rec;
   sync::StampMerge p(merge(0, 60), rec);
   feed_jittery(p);
-  // b@2 is late (lateness 1): the wait becomes 2. a@5: watermark 3, 3 stays;
-  // a@6: watermark 4, 3 goes; b@4.5 is after it and below nothing released: kept.
+  // b@0.5 is late (2.5 behind): the wait becomes 5. a@5, a@6: watermarks 0
+  // and 1, 3 stays; b@4.5 is after the last set (1): kept, and checked in order.
   EXPECT_EQ(rec.late(), 1u);
   EXPECT_EQ(rec.released.at(3).first, sync::Release::Late);
   EXPECT_EQ(rec.released.at(6).first, sync::Release::Used);
@@ -88,13 +88,13 @@ TEST(MergeLate, ProcessLateChecksItAsTheNextEvent) {
   sync::StampMerge p(merge(0, 0, true), rec);
   feed_jittery(p);
   EXPECT_EQ(rec.late(), 0u);
-  // b@2 comes after the set at 1: a set of its own just above 1; b@4.5
+  // b@0.5 comes after the set at 1: a set of its own just above 1; b@4.5
   // after the set at 5: just above 5. Every message is used exactly once.
   ASSERT_EQ(rec.sets.size(), 6u);
   EXPECT_EQ(rec.sets[1].first, std::nextafter(1.0, 2.0));
   EXPECT_EQ(rec.sets[1].second, (std::vector<uint64_t>{3}));
-  EXPECT_EQ(rec.sets[3].first, std::nextafter(5.0, 6.0));
-  EXPECT_EQ(rec.sets[3].second, (std::vector<uint64_t>{6}));
+  EXPECT_EQ(rec.sets[4].first, std::nextafter(5.0, 6.0));
+  EXPECT_EQ(rec.sets[4].second, (std::vector<uint64_t>{6}));
   for (size_t i = 1; i < rec.sets.size(); ++i) EXPECT_LT(rec.sets[i - 1].first, rec.sets[i].first);
   for (uint64_t token = 1; token <= 6; ++token) {
     EXPECT_EQ(rec.releases_of(token), 1) << token;
