@@ -69,8 +69,9 @@ def test_typed_dds_topic(rvc, tmp_path, transport):
     trace = write(tmp_path / "gear.jsonl", rows)
     net = Net("dds")
     gear = "autoware_auto_vehicle_msgs/msg/GearReport"
+    # A typed topic carries no end-of-stream marker (docs/ros2-types.md): the run ends when it is idle.
     mon = subprocess.Popen([rvc, "monitor", "--spec", "{report >= 1}", "--input", net.topic, "--type", gear,
-                            "--exit-on-eos", "--output", f"file:{tmp_path / 'v.jsonl'}", *net.monitor_flags],
+                            "--idle-timeout", "3", "--output", f"file:{tmp_path / 'v.jsonl'}", *net.monitor_flags],
                            stderr=subprocess.PIPE, text=True)
     try:
         rep = subprocess.run([rvc, "replay", trace, "--to", net.topic, "--type", gear, "--rate", "max",
