@@ -16,6 +16,7 @@ namespace rvc::cli {
 inline constexpr double kMaxSeconds = 86400 * 7;    // timeouts, intervals: a week
 inline constexpr double kMaxDelaySeconds = 3600;   // --max-delay: an hour of stamps held back
 inline constexpr double kAdaptiveDelayLimit = 60;  // merge: how far the wait adapts to the lateness seen
+inline constexpr double kMaxMergeHeld = 1000000;   // merge: messages held while waiting for an input
 inline constexpr double kMaxQueue = 1 << 24;        // --queue: frames between transport and engine
 inline constexpr double kMaxSyncQueue = 1 << 20;    // --sync-queue: messages kept per input
 inline constexpr double kMaxWitness = 10000;        // --witness: messages stored with a violation

@@ -171,6 +171,10 @@ runtime::SyncOptions SyncFlags::options(const std::vector<runtime::SyncInput>& i
   // Files (all of them: a mix with topics is refused) are read in stamp order.
   o.ordered = !inputs.empty();
   for (const auto& in : inputs) o.ordered = o.ordered && transport::scheme_of(in.uri) == "file";
+  // Live inputs and bags: a stamp waits until every input has passed it (an
+  // input silent for --dead-after seconds, or ended, is no longer waited for).
+  p.wait_for_inputs = !o.ordered;
+  p.max_held = static_cast<size_t>(kMaxMergeHeld);
   if (!pivot.empty()) p.pivot = static_cast<int>(index_of(inputs, pivot, "--pivot"));
   if (!lower_bounds.empty()) {
     p.inter_message_lower_bound.assign(inputs.size(), 0);

@@ -29,6 +29,7 @@ struct SyncedPipeline::Input {
   // Ordered inputs (SyncOptions::ordered): its next message, decoded and
   // waiting for the merge by stamp; whether it has ended; its last stamp.
   bool has_pending = false, ended = false, any_stamp = false;
+  bool excluded = false;  // the merge no longer waits for it (silent, or ended)
   sync::Member pending;
   double last_stamp = 0;
   std::string position_name;  // "input gear line", "input gear seq": names its messages
@@ -269,6 +270,11 @@ void SyncedPipeline::accept(uint32_t input, const uint8_t* values, double time, 
     }
   }
   ++in.counters.decoded;
+  if (in.excluded && !in.ended) {  // back after a silence: the merge waits for it again
+    in.excluded = false;
+    in.counters.reported_dead = false;  // a second silence is reported again
+    policy_->exclude(input, false);
+  }
   const sync::Member member{input, stamp, token};
   if (sync_.ordered) {
     in.pending = member;
@@ -297,7 +303,10 @@ int SyncedPipeline::next_input() {
 }
 
 void SyncedPipeline::input_ended(uint32_t input) {
-  if (input < inputs_.size()) inputs_[input].ended = true;
+  if (input >= inputs_.size()) return;
+  inputs_[input].ended = true;
+  inputs_[input].excluded = true;  // nothing more will come: do not wait for it
+  policy_->exclude(input, true);
 }
 
 uint64_t SyncedPipeline::received() const {
@@ -399,8 +408,11 @@ void SyncedPipeline::check_health(double now) {
     if (in.counters.reported_dead || (in.counters.received && silent <= sync_.dead_after)) continue;
     if (!in.counters.received && now - first_arrival_ <= sync_.dead_after) continue;
     in.counters.reported_dead = true;
+    // Do not hold the others' messages for it any longer (merge).
+    in.excluded = true;
+    policy_->exclude(static_cast<uint32_t>(&in - inputs_.data()), true);
     std::string what = sync_.policy == sync::PolicyKind::Merge
-                           ? "its fields hold their last values"
+                           ? "its fields hold their last values, and the others' messages no longer wait for it"
                            : std::string("no ") + sync::to_string(sync_.policy) + " set can form without it";
     std::fprintf(stderr, "rvc: warning: input '%s' (%s): %s while the others deliver: %s\n", in.spec.name.c_str(),
                  in.spec.uri.c_str(),

@@ -93,6 +93,13 @@ struct PolicyOptions {
   // double above it): checked as the next event, since the events after its
   // own stamp have been checked already.
   bool process_late = false;
+  // merge: also wait for every input: a stamp goes out only once each input
+  // not excluded (exclude(): silent, ended) has delivered a later one. Each
+  // input is in stamp order itself, so publishers that start or run apart do
+  // not make each other's messages late. max_held bounds what this may hold:
+  // past it the earliest goes out regardless.
+  bool wait_for_inputs = false;
+  size_t max_held = std::numeric_limits<size_t>::max();
   // latest: the input whose messages make sets; -1: the fastest so far
   // (smallest mean interval between its stamps; ties: the lower input).
   int pivot = -1;
@@ -108,6 +115,12 @@ class Policy {
   // new messages (a caller whose stamps follow a clock calls this while idle).
   // Others: no effect.
   virtual void advance(double stamp) { (void)stamp; }
+  // merge with wait_for_inputs: stop (or start again) waiting for an input,
+  // e.g. one that has gone silent or has ended. Others: no effect.
+  virtual void exclude(uint32_t input, bool excluded) {
+    (void)input;
+    (void)excluded;
+  }
   // End of stream: merge releases what it holds as sets in stamp order; the
   // others release what they hold as Unfinished (latest: Used if a set used it).
   // The policy is then empty, as new, and may take another stream.

@@ -89,6 +89,8 @@ StampMerge::StampMerge(const PolicyOptions& options, Handler& handler)
       max_delay_(options.max_delay),
       adaptive_limit_(options.adaptive_limit),
       process_late_(options.process_late),
+      wait_for_inputs_(options.wait_for_inputs),
+      max_held_(std::max<size_t>(options.max_held, 1)),
       delay_(options.max_delay),
       newest_(-kInf) {
   if (options.inputs == 0 || options.inputs > std::numeric_limits<uint32_t>::max())
@@ -96,7 +98,23 @@ StampMerge::StampMerge(const PolicyOptions& options, Handler& handler)
   if (!(max_delay_ >= 0)) throw std::invalid_argument("merge: max_delay must be >= 0");
   if (!(adaptive_limit_ >= 0)) throw std::invalid_argument("merge: adaptive_limit must be >= 0");
   newest_of_.assign(n_, -kInf);
+  excluded_.assign(n_, 0);
   members_.reserve(n_);
+}
+
+double StampMerge::watermark() const {
+  const double delayed = newest_ - delay_;
+  if (!wait_for_inputs_) return delayed;
+  double slowest = kInf;
+  for (uint32_t i = 0; i < n_; ++i)
+    if (!excluded_[i]) slowest = std::min(slowest, newest_of_[i]);
+  return std::min(slowest, delayed);
+}
+
+void StampMerge::exclude(uint32_t input, bool excluded) {
+  if (input >= n_) return;
+  excluded_[input] = excluded;
+  release_below(watermark());
 }
 
 void StampMerge::add(const Member& arrived) {
@@ -164,12 +182,16 @@ void StampMerge::add(const Member& arrived) {
   // other stamp held is above the last set's), and a second late message of
   // its input must not find it still held and replace it.
   if (late) release_top();
-  else release_below(newest_ - delay_);
+  else release_below(watermark());
+  while (held_ > max_held_) release_top();  // memory bound: the earliest goes, later ones of it may be late
 }
 
 void StampMerge::advance(double stamp) {
   if (stamp > newest_) newest_ = stamp;  // NaN compares false: ignored
-  release_below(newest_ - delay_);
+  // Stamps that follow a clock: no input can still deliver an earlier one.
+  for (double& n : newest_of_)
+    if (stamp > n) n = stamp;
+  release_below(watermark());
 }
 
 void StampMerge::release_below(double watermark) {
@@ -205,6 +227,7 @@ void StampMerge::finish() {
   newest_of_.assign(n_, -kInf);
   newest_ = -kInf;
   delay_ = max_delay_;
+  excluded_.assign(n_, 0);
   any_set_ = false;
 }
 

@@ -29,6 +29,7 @@ class StampMerge final : public Policy {
 
   void add(const Member& message) override;
   void advance(double stamp) override;
+  void exclude(uint32_t input, bool excluded) override;
   void finish() override;
   size_t held() const override { return held_; }
   double delay() const { return delay_; }  // the watermark's delay now (adapted)
@@ -60,6 +61,7 @@ class StampMerge final : public Policy {
   };
 
   void release_below(double watermark);
+  double watermark() const;  // stamps below it go out
   void release_top();
 
   Handler& handler_;
@@ -67,6 +69,9 @@ class StampMerge final : public Policy {
   const double max_delay_;
   const double adaptive_limit_;
   const bool process_late_;
+  const bool wait_for_inputs_;
+  const size_t max_held_;
+  std::vector<uint8_t> excluded_;  // wait_for_inputs: inputs not waited for
   double delay_;  // max_delay_, grown by adaptation
   std::vector<Node> nodes_;
   uint32_t free_node_ = kNone;

@@ -193,3 +193,58 @@ TEST(MergeFiles, AStampThatGoesBackIsRejectedAtItsLine) {
 
 }  // namespace
 }  // namespace rvc
+
+namespace rvc {
+namespace {
+
+// Live publishers that start apart: a's whole stream before b's first
+// message. Waiting for every input, nothing is late; without, all of b is.
+TEST(MergeWait, APublisherThatStartsLateLosesNothing) {
+  for (bool wait : {false, true}) {
+    Sets rec;
+    sync::PolicyOptions o = merge(0, 60);
+    o.wait_for_inputs = wait;
+    sync::StampMerge p(o, rec);
+    uint64_t token = 0;
+    for (int k = 0; k < 100; ++k) p.add({0, static_cast<double>(k), ++token});
+    EXPECT_EQ(p.held(), wait ? 100u : 1u);
+    for (int k = 0; k < 100; ++k) p.add({1, k + 0.5, ++token});
+    p.finish();
+    // Without waiting: a's 0..98 are out, b's 0.5..97.5 late (98), 98.5 and 99.5 in time.
+    EXPECT_EQ(rec.late(), wait ? 0u : 98u);
+    EXPECT_EQ(rec.sets.size(), wait ? 200u : 102u);
+  }
+}
+
+TEST(MergeWait, ASilentOrEndedInputIsNoLongerWaitedFor) {
+  Sets rec;
+  sync::PolicyOptions o = merge(0, 0);
+  o.wait_for_inputs = true;
+  sync::StampMerge p(o, rec);
+  p.add({0, 1, 1});
+  p.add({0, 2, 2});
+  EXPECT_TRUE(rec.sets.empty());  // b has said nothing yet
+  p.exclude(1, true);             // b silent (--dead-after) or ended
+  EXPECT_EQ(rec.sets.size(), 1u);  // 1 goes; 2 waits for a later stamp, as without waiting
+  p.exclude(1, false);            // b is back: wait for it again
+  p.add({0, 3, 3});
+  EXPECT_EQ(rec.sets.size(), 1u);
+  p.add({1, 2.5, 4});
+  EXPECT_EQ(rec.sets.size(), 2u);  // 2 < min(3, 2.5)
+  p.finish();
+  EXPECT_EQ(rec.late(), 0u);
+}
+
+TEST(MergeWait, HeldMessagesAreBounded) {
+  Sets rec;
+  sync::PolicyOptions o = merge(0, 0);
+  o.wait_for_inputs = true;
+  o.max_held = 10;
+  sync::StampMerge p(o, rec);
+  for (int k = 0; k < 50; ++k) p.add({0, static_cast<double>(k), static_cast<uint64_t>(k + 1)});
+  EXPECT_EQ(p.held(), 10u);
+  EXPECT_EQ(rec.sets.size(), 40u);
+}
+
+}  // namespace
+}  // namespace rvc
