@@ -487,9 +487,9 @@ Runner register_monitor(CLI::App& app) {
       ->capture_default_str();
   add_transport_options(*sub, cmd->transports);
   sub->footer(
-      "Exit status: 0 all held, 1 a property was violated, 2 usage/spec error, 3 messages rejected, 4 messages lost,\n"
-      "5 runtime failure (an output could not be written), 6 incomplete (nothing received, or no end-of-stream\n"
-      "marker with --exit-on-eos).\n"
+      "Exit status: 0 all held, 1 a property was violated, 2 usage/spec error, 3 messages rejected (or dropped as\n"
+      "late), 4 messages lost, 5 runtime failure (an output could not be written), 6 incomplete (nothing received\n"
+      "or checked, or no end-of-stream marker with --exit-on-eos).\n"
       "Example: rvc monitor --spec 'historically({emergency} -> once[0:1]{hazard_lights})' \\\n"
       "           --input zenoh:vehicle/status --output zenoh:rv/verdicts");
   return [cmd] { return cmd->run(); };
