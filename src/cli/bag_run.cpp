@@ -21,6 +21,7 @@ BagRun run_bag(const std::string& path, const std::vector<std::string>& topics,
     run.stats = pipeline.stats();
     run.stats.rejected += skipped;  // the bag's bad records: rejected input like a malformed message
     run.violations = pipeline.violations();
+    run.received = pipeline.received();
     return run;
   }
   std::vector<runtime::BagInput> bags;
@@ -40,6 +41,8 @@ BagRun run_bag(const std::string& path, const std::vector<std::string>& topics,
   run.stats = pipeline.stats();
   run.stats.rejected += skipped;
   run.violations = pipeline.violations();
+  run.received = pipeline.received();
+  pipeline.add_dropped(run.dropped);
   return run;
 }
 

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "cli/sync_options.hpp"
+#include "io/json_writer.hpp"
 #include "msg/type_registry.hpp"
 #include "runtime/check_bag.hpp"
 #include "runtime/verdict_outputs.hpp"
@@ -18,6 +19,8 @@ struct BagRun {
   runtime::PipelineStats stats;
   uint64_t violations = 0;
   uint64_t messages = 0;    // of the chosen topics
+  uint64_t received = 0;    // of those, given to the pipeline (all of them unless the bag broke off)
+  io::JsonObject dropped;   // by the synchronizer, by reason
   std::string topic;        // the chosen topic (several: joined by ",")
   std::string description;  // "topic /a (pkg/msg/T, 12 messages)", or the inputs
 };

@@ -1,5 +1,6 @@
 #include "cli/check_options.hpp"
 
+#include "cli/option_ranges.hpp"
 #include "io/properties_file.hpp"
 
 namespace rvc::cli {
@@ -18,13 +19,16 @@ void CheckOptions::add_to(CLI::App& app) {
   app.add_option("--max-data-values", max_data_values,
                  "Data references (exists[x]. {id: *x}): the most distinct values one variable may take; more stops "
                  "the run with an error (memory and time per message grow with them)")
+      ->check(in_range(1, kMaxDataValues))
       ->capture_default_str();
   app.add_flag("--strict", strict, "Reject messages missing a field a property tests, or with wrong types");
   app.add_option("--time-field", time_field,
                  "Field holding the time in dense time: a path (header.stamp) to seconds or a Time {sec, nanosec} "
                  "(typed input without it: the message's header.stamp or stamp)")
       ->capture_default_str();
-  app.add_option("--max-message-size", max_message_size, "Longest accepted message in bytes")->capture_default_str();
+  app.add_option("--max-message-size", max_message_size, "Longest accepted message in bytes")
+      ->check(in_range(1, kMaxMessageSize, "bytes"))
+      ->capture_default_str();
   app.add_option("--max-errors", max_reported, "Errors and warnings printed before going quiet (all are counted)")
       ->capture_default_str();
   app.add_flag("--parse-only", parse_only, "Decode messages but run no monitor (the benchmark's floor)")

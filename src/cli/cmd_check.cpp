@@ -34,6 +34,7 @@ struct CheckCommand {
   std::string output = "-";
   StoreFlags store;
   bool summary = false;
+  bool stats = false;  // --stats: the counters as one JSON line on stderr, as the monitor's
   std::vector<std::string> topics;  // --topic: which topic(s) of a bag
   SyncFlags sync;                   // several topics
   msg::TypeRegistry registry;  // types from a bag's schemas
@@ -48,7 +49,7 @@ struct CheckCommand {
     if (!outputs.empty()) output = outputs[0];
     auto properties = check.properties();
     const std::string path = strip_file_scheme(input), opath = strip_file_scheme(output);
-    if (path != "-" && opath != "-" && runtime::same_regular_file(path, opath)) {
+    if (opath != "-" && runtime::same_regular_file(path, opath)) {
       std::fprintf(stderr, "rvc: --output '%s' is the trace being read: refusing to overwrite it\n", opath.c_str());
       return kUsage;
     }
@@ -97,6 +98,12 @@ struct CheckCommand {
                    path == "-" ? "stdin" : path.c_str());
       outcome.incomplete = true;
     }
+    if (stats) {
+      io::JsonObject counters;
+      counters.add("input", input);
+      runtime::add_run_counters(counters, pipeline, outputs.count());
+      std::fprintf(stderr, "%s\n", counters.str().c_str());
+    }
     if (results)
       results->finish(outcome, stopped ? "signal" : "end of input",
                       counters_json(pipeline.stats(), pipeline.violations()));
@@ -131,6 +138,20 @@ struct CheckCommand {
     BagRun run = cli::run_bag(path, topics, properties, popts, sync, registry, outputs);
     if (summary) std::fprintf(stderr, "rvc check: %s, %s\n", path.c_str(), run.description.c_str());
     report(run.stats, run.violations);
+    if (stats) {
+      const std::string counters = io::JsonObject()
+                                       .add("input", input)
+                                       .add("topic", run.topic)
+                                       .add("received", run.received)
+                                       .add("checked", run.stats.accepted)
+                                       .add("rejected", run.stats.rejected)
+                                       .add("dropped", run.dropped)
+                                       .add("warnings", run.stats.warnings)
+                                       .add("verdicts", outputs.count())
+                                       .add("violations", run.violations)
+                                       .str();
+      std::fprintf(stderr, "%s\n", counters.c_str());
+    }
     if (results) results->finish(run.outcome, "end of bag", counters_json(run.stats, run.violations));
     return run.outcome.exit_code();
 #else
@@ -179,10 +200,14 @@ Runner register_check(CLI::App& app) {
                   "sqlite:PATH or postgresql://... (docs/results.md)");
   cmd->store.add_to(*sub);
   sub->add_flag("--summary", cmd->summary, "Print message counts to stderr at the end");
+  sub->add_flag("--stats", cmd->stats,
+                "Print the counters as one JSON line on stderr at the end (received, checked, rejected, dropped by "
+                "reason, warnings, verdicts, violations), as rvc monitor does");
   sub->footer(
       "Exit status: 0 all properties held, 1 a property was violated, 2 usage or spec error, 3 messages were\n"
-      "rejected, 5 runtime failure (the trace could not be read, verdicts or results could not be written),\n"
-      "6 stopped by SIGINT/SIGTERM before the end of the trace (what was read is checked and stored).\n"
+      "rejected (or dropped as late), 5 runtime failure (the trace could not be read, verdicts or results could\n"
+      "not be written), 6 nothing was checked (an empty trace, every message rejected or unmatched) or stopped\n"
+      "by SIGINT/SIGTERM before the end of the trace (what was read is checked and stored).\n"
       "Example: rvc check --spec 'historically({emergency} -> once[0:1]{hazard_lights})' trace.jsonl");
   return [cmd] { return cmd->run(); };
 }

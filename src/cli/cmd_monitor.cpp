@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "cli/check_options.hpp"
+#include "cli/option_ranges.hpp"
 #include "cli/commands.hpp"
 #include "cli/store_options.hpp"
 #include "cli/transport_flags.hpp"
@@ -85,12 +86,24 @@ struct MonitorCommand {
   }
 
   // The enforcer's endpoints, opened with the outputs (and waited for like them).
-  int open_enforcer(const std::vector<engine::PropertySpec>& properties, runtime::VerdictOutputs& verdicts) {
+  // A command endpoint the monitor reads is refused before anything is
+  // opened: a file would be truncated before it is read, a key or topic
+  // would feed each command back as a message (without end, once violated).
+  int open_enforcer(const std::vector<engine::PropertySpec>& properties, runtime::VerdictOutputs& verdicts,
+                    const std::vector<std::string>& input_uris) {
     if (on_violation.empty()) return 0;
     std::vector<runtime::EnforceAction> actions;
     for (const auto& text : on_violation) {
       actions.push_back(runtime::parse_enforce_action(text));
       if (int status = check_property_name(actions.back().property, properties, "--on-violation")) return status;
+      for (const auto& in : input_uris)
+        if (transport::reads_back(in, actions.back().uri)) {
+          std::fprintf(stderr,
+                       "rvc: --on-violation %s: '%s' would be read back by the input '%s': refusing to send commands "
+                       "to the monitor's own input\n",
+                       actions.back().property.c_str(), actions.back().uri.c_str(), in.c_str());
+          return kUsage;
+        }
     }
     const msg::MessageType* type = nullptr;
     transport::TransportOptions command_transports = transports;
@@ -169,8 +182,10 @@ struct MonitorCommand {
                                   .add("input", input)
                                   .add("topic", run.topic)
                                   .add("messages", run.messages)
+                                  .add("received", run.received)
                                   .add("checked", run.stats.accepted)
                                   .add("rejected", run.stats.rejected)
+                                  .add("dropped", run.dropped)
                                   .add("warnings", run.stats.warnings)
                                   .add("verdicts", verdicts.count())
                                   .add("violations", run.violations)
@@ -191,7 +206,7 @@ struct MonitorCommand {
   // intersecting key expression, the same topic) feeds the monitor its own
   // verdicts without end.
   bool refuse_own_input(const std::string& output, const std::string& in) const {
-    if (!transport::endpoints_overlap(in, output)) return false;
+    if (!transport::reads_back(in, output)) return false;
     std::fprintf(stderr, "rvc: output '%s' would be read back by the input '%s': refusing to monitor its own output\n",
                  output.c_str(), in.c_str());
     return true;
@@ -271,7 +286,7 @@ struct MonitorCommand {
     std::vector<std::unique_ptr<transport::Sink>> sinks;
     if (int status = open_outputs(sinks, stats_sink)) return status;
     runtime::VerdictOutputs verdicts = make_verdicts(std::move(sinks));
-    if (int status = open_enforcer(properties, verdicts)) return status;
+    if (int status = open_enforcer(properties, verdicts, uris)) return status;
     runtime::PipelineOptions popts = check.pipeline_options();
     popts.position_name = files ? "line" : "seq";
     // --sets-output: what the properties saw, for `rvc check` to replay.
@@ -341,7 +356,7 @@ struct MonitorCommand {
     std::vector<std::unique_ptr<transport::Sink>> sinks;
     if (int status = open_outputs(sinks, stats_sink)) return status;
     runtime::VerdictOutputs verdicts = make_verdicts(std::move(sinks));
-    if (int status = open_enforcer(properties, verdicts)) return status;
+    if (int status = open_enforcer(properties, verdicts, {input})) return status;
     runtime::PipelineOptions popts = check.pipeline_options();
     popts.position_name = "seq";
     if (transport::scheme_of(input) == "mcap") return run_bag(properties, popts, verdicts);
@@ -430,7 +445,7 @@ Runner register_monitor(CLI::App& app) {
                   "p1=zenoh:vehicle/hazard:{\"on\":true} (docs/enforcer.md)");
   sub->add_option("--debounce", cmd->debounce,
                   "Enforcer: at least S seconds between two commands of one --on-violation")
-      ->check(CLI::NonNegativeNumber)
+      ->check(in_range(0, kMaxSeconds, "seconds"))
       ->capture_default_str();
   sub->add_option("--command-type", cmd->command_type,
                   "Enforcer: send commands on dds:/zenoh: as CDR samples of this type (their PAYLOAD is its JSON), e.g. "
@@ -440,12 +455,13 @@ Runner register_monitor(CLI::App& app) {
   sub->add_option("--publishers", cmd->publishers,
                   "With --exit-on-eos: wait for the end-of-stream markers of at least N publishers (and of every "
                   "publisher seen)")
-      ->check(CLI::PositiveNumber)
+      ->check(in_range(1, 100000))
       ->capture_default_str();
   sub->add_option("--idle-timeout", cmd->idle_timeout,
                   "Give up after S seconds without any message (0: wait forever); with --exit-on-eos that is exit 6")
-      ->check(CLI::NonNegativeNumber);
-  sub->add_option("--stats-interval", cmd->stats_interval, "Print counters every S seconds (also on SIGUSR1)");
+      ->check(in_range(0, kMaxSeconds, "seconds"));
+  sub->add_option("--stats-interval", cmd->stats_interval, "Print counters every S seconds (also on SIGUSR1)")
+      ->check(in_range(0, kMaxSeconds, "seconds"));
   sub->add_option("--stats-output", cmd->stats_output, "Also publish the counters (JSON) to this endpoint");
   sub->add_option("--verdict-type", cmd->verdict_type,
                   "Publish verdicts on dds:/zenoh: outputs as this ROS 2 type (rvc_msgs/msg/Verdict: time, property, "
@@ -454,8 +470,11 @@ Runner register_monitor(CLI::App& app) {
                   "Several inputs: also publish each synchronized set (JSON, as rvc sync) to this endpoint");
   sub->add_option("--wait-subscribers", cmd->wait_subscribers,
                   "Before reading the input, wait for this many subscribers on each zenoh:/dds: output")
+      ->check(in_range(0, 100000))
       ->capture_default_str();
-  sub->add_option("--wait-timeout", cmd->wait_timeout, "Seconds to wait for them")->capture_default_str();
+  sub->add_option("--wait-timeout", cmd->wait_timeout, "Seconds to wait for them")
+      ->check(in_range(0, kMaxSeconds, "seconds"))
+      ->capture_default_str();
   cmd->typed.add_to(*sub,
                     "Message type of the input's CDR payloads: ROS 2 pkg/msg/Name (`rvc msg list`, `rvc msg show`) or a DDS IDL name from --msg-path; "
                     "several inputs: after the --input it is for, or NAME=pkg/msg/Name");
@@ -463,12 +482,14 @@ Runner register_monitor(CLI::App& app) {
   sub->add_option("--topic", cmd->topics,
                   "With --input mcap:BAG: the topic to check (if the bag holds several); repeatable: NAME=TOPIC, "
                   "synchronized by --sync");
-  sub->add_option("--queue", cmd->queue_capacity, "Messages buffered between transport and engine")->capture_default_str();
+  sub->add_option("--queue", cmd->queue_capacity, "Messages buffered between transport and engine")
+      ->check(in_range(1, kMaxQueue))
+      ->capture_default_str();
   add_transport_options(*sub, cmd->transports);
   sub->footer(
-      "Exit status: 0 all held, 1 a property was violated, 2 usage/spec error, 3 messages rejected, 4 messages lost,\n"
-      "5 runtime failure (an output could not be written), 6 incomplete (nothing received, or no end-of-stream\n"
-      "marker with --exit-on-eos).\n"
+      "Exit status: 0 all held, 1 a property was violated, 2 usage/spec error, 3 messages rejected (or dropped as\n"
+      "late), 4 messages lost, 5 runtime failure (an output could not be written), 6 incomplete (nothing received\n"
+      "or checked, or no end-of-stream marker with --exit-on-eos).\n"
       "Example: rvc monitor --spec 'historically({emergency} -> once[0:1]{hazard_lights})' \\\n"
       "           --input zenoh:vehicle/status --output zenoh:rv/verdicts");
   return [cmd] { return cmd->run(); };

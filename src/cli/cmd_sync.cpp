@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "cli/commands.hpp"
+#include "cli/option_ranges.hpp"
 #include "cli/output_sinks.hpp"
 #include "cli/signals.hpp"
 #include "cli/sync_options.hpp"
@@ -75,7 +76,7 @@ struct SyncCommand {
       names.push_back(in.name);
       files += transport::scheme_of(in.uri) == "file";
       for (const auto& out : outputs)
-        if (transport::endpoints_overlap(in.uri, out)) {
+        if (transport::reads_back(in.uri, out)) {
           std::fprintf(stderr, "rvc: output '%s' would be read back by the input '%s'\n", out.c_str(), in.uri.c_str());
           return kUsage;
         }
@@ -152,16 +153,22 @@ Runner register_sync(CLI::App& app) {
   sub->add_option("--time-field", cmd->time_field, "JSON inputs: the field holding the stamp (seconds)")
       ->capture_default_str();
   sub->add_option("--max-message-size", cmd->max_message_size, "Longest accepted message in bytes")
+      ->check(in_range(1, kMaxMessageSize, "bytes"))
       ->capture_default_str();
   sub->add_flag("--exit-on-eos", cmd->exit_on_eos, "Exit after every input's end-of-stream marker");
   sub->add_option("--publishers", cmd->publishers, "With --exit-on-eos: publishers per input to wait for")
-      ->check(CLI::PositiveNumber);
-  sub->add_option("--idle-timeout", cmd->idle_timeout, "Give up after S seconds without any message (0: never)");
-  sub->add_option("--stats-interval", cmd->stats_interval, "Print counters every S seconds (also on SIGUSR1)");
+      ->check(in_range(1, 100000));
+  sub->add_option("--idle-timeout", cmd->idle_timeout, "Give up after S seconds without any message (0: never)")
+      ->check(in_range(0, kMaxSeconds, "seconds"));
+  sub->add_option("--stats-interval", cmd->stats_interval, "Print counters every S seconds (also on SIGUSR1)")
+      ->check(in_range(0, kMaxSeconds, "seconds"));
   sub->add_option("--stats-output", cmd->stats_output, "Also publish the counters (JSON) to this endpoint");
   sub->add_option("--wait-subscribers", cmd->wait_subscribers,
-                  "Before reading the inputs, wait for this many subscribers on each zenoh:/dds: output");
-  sub->add_option("--wait-timeout", cmd->wait_timeout, "Seconds to wait for them")->capture_default_str();
+                  "Before reading the inputs, wait for this many subscribers on each zenoh:/dds: output")
+      ->check(in_range(0, 100000));
+  sub->add_option("--wait-timeout", cmd->wait_timeout, "Seconds to wait for them")
+      ->check(in_range(0, kMaxSeconds, "seconds"))
+      ->capture_default_str();
   add_transport_options(*sub, cmd->transports);
   sub->footer(
       "Each set: {\"time\": STAMP, \"NAME\": message, ...}; merge sets hold every input's latest message.\n"

@@ -3,6 +3,7 @@
 #include <cstdio>
 
 #include "cli/signals.hpp"
+#include "cli/option_ranges.hpp"
 
 namespace rvc::cli {
 
@@ -26,10 +27,11 @@ const std::string& command_line() { return command_line_text(); }
 void StoreFlags::add_to(CLI::App& app) {
   app.add_option("--witness", options.witness,
                  "With a database output: input messages stored with each violation (the last N up to it)")
+      ->check(in_range(0, kMaxWitness))
       ->capture_default_str();
   app.add_option("--db-wait", options.wait_seconds,
                  "With a database output: seconds the end of the run waits for a database that went away")
-      ->check(CLI::NonNegativeNumber)
+      ->check(in_range(0, kMaxSeconds, "seconds"))
       ->capture_default_str();
   app.add_option("--spool", options.spool,
                  "With a database output: file for results kept while the database is away (default: the SQLite "

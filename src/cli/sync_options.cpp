@@ -1,6 +1,9 @@
 #include "cli/sync_options.hpp"
 
+#include "cli/option_ranges.hpp"
+
 #include <cctype>
+#include <cmath>
 #include <stdexcept>
 
 namespace rvc::cli {
@@ -36,23 +39,29 @@ void SyncFlags::add_to(CLI::App& app) {
       ->check(CLI::IsMember({"merge", "approximate", "exact", "latest"}))
       ->capture_default_str();
   app.add_option("--sync-queue", queue_size, "approximate/exact: messages kept per input (message_filters queue size)")
-      ->check(CLI::PositiveNumber)
+      ->check(in_range(1, kMaxSyncQueue))
       ->capture_default_str();
   app.add_option("--max-interval", max_interval, "approximate: widest set in seconds (newest - oldest stamp)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(in_range(0, HUGE_VAL, "seconds"));
   app.add_option("--age-penalty", age_penalty, "approximate: message_filters' age penalty")
-      ->check(CLI::NonNegativeNumber)
+      ->check(in_range(0, 1e9))
       ->capture_default_str();
   app.add_option("--lower-bound", lower_bounds,
                  "approximate: NAME=SECONDS, the least time between two messages of input NAME (sets go out sooner)");
   app.add_option("--max-delay", max_delay,
-                 "merge: seconds a message waits for earlier-stamped ones from other inputs; later ones are late")
-      ->check(CLI::NonNegativeNumber)
+                 "merge: least seconds a message waits for earlier-stamped ones from other inputs (the wait grows to twice "
+                 "the lateness seen, up to 60 s or this); later ones are late")
+      ->check(in_range(0, kMaxDelaySeconds, "seconds"))
+      ->capture_default_str();
+  app.add_option("--late", late,
+                 "merge: what becomes of a message stamped before an event already checked: drop it (counted, "
+                 "warned, exit 3) or process it as the next event")
+      ->check(CLI::IsMember({"drop", "process"}))
       ->capture_default_str();
   app.add_option("--pivot", pivot, "latest: the input whose messages make sets (default: the fastest)");
   app.add_option("--dead-after", dead_after,
                  "Warn about an input silent for S seconds while the others deliver (0: never)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(in_range(0, kMaxSeconds, "seconds"))
       ->capture_default_str();
 }
 
@@ -156,6 +165,16 @@ runtime::SyncOptions SyncFlags::options(const std::vector<runtime::SyncInput>& i
   p.max_interval = max_interval;
   p.age_penalty = age_penalty;
   p.max_delay = max_delay;
+  // Live stamps jitter: the wait adapts to the lateness seen (docs/sync.md).
+  p.adaptive_limit = kAdaptiveDelayLimit;
+  p.process_late = late == "process";
+  // Files (all of them: a mix with topics is refused) are read in stamp order.
+  o.ordered = !inputs.empty();
+  for (const auto& in : inputs) o.ordered = o.ordered && transport::scheme_of(in.uri) == "file";
+  // Live inputs and bags: a stamp waits until every input has passed it (an
+  // input silent for --dead-after seconds, or ended, is no longer waited for).
+  p.wait_for_inputs = !o.ordered;
+  p.max_held = static_cast<size_t>(kMaxMergeHeld);
   if (!pivot.empty()) p.pivot = static_cast<int>(index_of(inputs, pivot, "--pivot"));
   if (!lower_bounds.empty()) {
     p.inter_message_lower_bound.assign(inputs.size(), 0);

@@ -4,7 +4,7 @@
 //   --input steer=zenoh:vehicle/status/steering_status --type ...   (a --type applies to the --input before it)
 //   --stamp gear=header.stamp | --stamp steer=arrival
 //   --sync approximate|exact|latest|merge (+ --sync-queue, --max-interval, --age-penalty, --lower-bound,
-//   --max-delay, --pivot, --dead-after)
+//   --max-delay, --late, --pivot, --dead-after)
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -28,6 +28,7 @@ struct SyncFlags {
   double age_penalty = 0.1;
   std::vector<std::string> lower_bounds;  // NAME=SECONDS
   double max_delay = 0;
+  std::string late = "drop";  // merge: drop|process late messages
   std::string pivot;
   double dead_after = 5;
 

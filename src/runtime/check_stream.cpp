@@ -1,5 +1,7 @@
 #include "runtime/check_stream.hpp"
 
+#include "runtime/monitor_loop.hpp"
+
 #include <sys/stat.h>
 
 #include <cstdio>
@@ -20,7 +22,27 @@ Outcome run_check(Feed& feed, VerdictOutputs& outputs, const std::function<void(
   feed.finish_report();
   outcome.violated = feed.violations() > 0;
   outcome.rejected = outcome.rejected || feed.stats().rejected > 0;
+  outcome.dropped = feed.lost() > 0;
+  // A run that checked nothing (an empty trace, every message rejected or
+  // unmatched) is no pass: exit 6, as the monitor's.
+  if (!outcome.runtime_failure && feed.stats().accepted == 0) {
+    std::fprintf(stderr, "rvc: nothing was checked: %s\n", nothing_checked(feed).c_str());
+    outcome.incomplete = true;
+  }
   return outcome;
+}
+
+void add_run_counters(io::JsonObject& out, const Feed& feed, uint64_t verdicts) {
+  const PipelineStats& s = feed.stats();
+  io::JsonObject dropped;
+  feed.add_dropped(dropped);
+  out.add("received", feed.received())
+      .add("checked", s.accepted)
+      .add("rejected", s.rejected)
+      .add("dropped", dropped)
+      .add("warnings", s.warnings)
+      .add("verdicts", verdicts)
+      .add("violations", feed.violations());
 }
 
 Outcome check_stream(int fd, Pipeline& pipeline, VerdictOutputs& outputs, io::ReaderOptions reader, bool live) {
@@ -36,7 +58,7 @@ Outcome check_stream(int fd, Pipeline& pipeline, VerdictOutputs& outputs, io::Re
 
 bool same_regular_file(const std::string& a, const std::string& b) {
   struct stat sa, sb;
-  if (::stat(a.c_str(), &sa) != 0 || ::stat(b.c_str(), &sb) != 0) return false;
+  if ((a == "-" ? ::fstat(0, &sa) : ::stat(a.c_str(), &sa)) != 0 || ::stat(b.c_str(), &sb) != 0) return false;
   return S_ISREG(sa.st_mode) && sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
 }
 

@@ -4,6 +4,7 @@
 
 #include <functional>
 
+#include "io/json_writer.hpp"
 #include "io/jsonl_reader.hpp"
 #include "runtime/exit_status.hpp"
 #include "runtime/pipeline.hpp"
@@ -24,8 +25,15 @@ Outcome check_stream(int fd, Pipeline& pipeline, VerdictOutputs& outputs, io::Re
 // releases what it holds).
 Outcome run_check(Feed& feed, VerdictOutputs& outputs, const std::function<void(Outcome&)>& read);
 
-// True if both paths name the same existing regular file (also through links):
-// used to refuse writing verdicts over the input being read.
+// The counters of a run, as the monitor's counters line has them: received,
+// checked, rejected, dropped (by reason), warnings, verdicts, violations.
+// rvc check --stats and a bag's run print them.
+void add_run_counters(io::JsonObject& out, const Feed& feed, uint64_t verdicts);
+
+// True if both paths name the same existing regular file (also through links,
+// compared by device and inode): used to refuse writing verdicts over the
+// input being read. `a` may be "-": stdin, and the file it was redirected
+// from (`rvc check - -o t.jsonl < t.jsonl`).
 bool same_regular_file(const std::string& a, const std::string& b);
 
 }  // namespace rvc::runtime

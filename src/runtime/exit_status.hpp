@@ -8,7 +8,7 @@ enum ExitCode : int {
   kOk = 0,          // every property held
   kViolated = 1,    // some property was violated
   kUsage = 2,       // bad arguments, bad spec, unreadable files: before anything ran
-  kBadInput = 3,    // messages were rejected (malformed, wrong time order, strict mode)
+  kBadInput = 3,    // messages were rejected (malformed, wrong time order, strict mode) or dropped as late
   kLost = 4,        // messages were lost or duplicated in transit (rvc monitor)
   kRuntime = 5,     // a runtime failure: an output could not be written, a read or transport error
   kIncomplete = 6,  // the stream did not end properly: nothing received, or no end-of-stream marker
@@ -25,13 +25,14 @@ struct Outcome {
   bool lost = false;
   bool incomplete = false;
   bool rejected = false;
+  bool dropped = false;  // messages the synchronizer dropped as late: skipped, not checked (exit 3)
 
   int exit_code() const {
     if (violated) return kViolated;
     if (runtime_failure) return kRuntime;
     if (lost) return kLost;
     if (incomplete) return kIncomplete;
-    if (rejected) return kBadInput;
+    if (rejected || dropped) return kBadInput;
     return kOk;
   }
 };

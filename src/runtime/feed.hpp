@@ -36,6 +36,22 @@ class Feed {
   virtual void idle() {}
   // Every input has ended (end-of-stream, file end): nothing more will come.
   virtual void end_of_input() {}
+  // Several file inputs: the feed chooses which input's next message it
+  // needs (a merge by stamp), and the caller reads that one. next_input()
+  // returns it, or -1 once every input has ended and all is fed.
+  virtual bool reads_in_order() const { return false; }
+  virtual int next_input() { return -1; }
+  // Input `input` has ended (its end-of-stream marker, its file's end).
+  virtual void input_ended(uint32_t input) { (void)input; }
+  // Messages given to the feed (a batch counts its lines): checked +
+  // rejected + dropped.
+  virtual uint64_t received() const { return stats().accepted + stats().rejected; }
+  // Messages dropped before a monitor saw them, by reason ("late": 3): the
+  // synchronizer's. The counters line's "dropped".
+  virtual void add_dropped(io::JsonObject& out) const { (void)out; }
+  // Of those, the ones the run meant to check and could not (late): such a
+  // run is not a clean pass (exit 3).
+  virtual uint64_t lost() const { return 0; }
   virtual const PipelineStats& stats() const = 0;
   virtual uint64_t violations() const = 0;
   // Prints "N more errors were not shown" if output was cut short.

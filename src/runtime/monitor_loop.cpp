@@ -38,6 +38,17 @@ class Shutdown {
 
 }  // namespace
 
+std::string nothing_checked(const Feed& feed, uint64_t filtered) {
+  const PipelineStats& s = feed.stats();
+  io::JsonObject dropped;
+  feed.add_dropped(dropped);
+  std::string why = std::to_string(feed.received()) + " message" + (feed.received() == 1 ? "" : "s") + " received, " +
+                    std::to_string(s.rejected) + " rejected";
+  if (filtered) why += ", " + std::to_string(filtered) + " filtered out";
+  if (dropped.str() != "{}") why += ", dropped " + dropped.str();
+  return why;
+}
+
 const char* to_string(EndReason reason) {
   switch (reason) {
     case EndReason::EndOfStream: return "eos";
@@ -69,7 +80,10 @@ std::string MonitorLoop::stats_json() const {
   out.add("input", options_.input)
       .add("received", total(&transport::SeqCounters::received))
       .add("checked", p.accepted)
-      .add("rejected", p.rejected)
+      .add("rejected", p.rejected);
+  io::JsonObject dropped;
+  feed_.add_dropped(dropped);
+  out.add("dropped", dropped)
       .add("warnings", p.warnings)
       .add("by_layout", p.by_layout)
       .add("gaps", total(&transport::SeqCounters::gaps))
@@ -107,10 +121,62 @@ void MonitorLoop::publish_stats() {
   if (stats_sink_) stats_sink_->put(js, 0);
 }
 
+void MonitorLoop::handle(const transport::Frame& f) {
+  transport::SeqCounters& counters = counters_[f.input];
+  if (f.eos) {
+    // Several publishers: the input ends when each has ended.
+    if (options_.sequence_numbers) counters.on_eos(f.seq, f.publisher);
+    input_eos_[f.input] = !options_.sequence_numbers ||
+                          (counters.all_ended() && counters.publishers() >= options_.publishers);
+    if (input_eos_[f.input]) feed_.input_ended(f.input);
+    if (!eos_ && ended()) {
+      eos_ = true;
+      feed_.end_of_input();
+    }
+    return;
+  }
+  std::string_view payload = f.payload;
+  if (options_.sequence_numbers) {
+    counters.on_seq(f.seq, f.publisher);
+  } else if (f.seq == 1 && payload.substr(0, io::kUtf8Bom.size()) == io::kUtf8Bom) {
+    // A file's byte-order mark, as `rvc check` treats it; on a line of
+    // its own it leaves a blank line, which is no message.
+    payload.remove_prefix(io::kUtf8Bom.size());
+    feed_.warn(io::LineError{1, 1, io::kBomStartWarning});
+    if (payload.find_first_not_of(" \t\r") == std::string_view::npos) return;
+  }
+  if (!options_.sequence_numbers) ++counters.received;
+  if (options_.filter) {  // after loss accounting: a filtered message was not lost
+    std::string_view key = f.key;
+    if (key.empty() && f.input < options_.key_of_input.size()) key = options_.key_of_input[f.input];
+    if (!options_.filter->admits(key)) {
+      ++filtered_;
+      return;
+    }
+    if (options_.filter->projecting() && options_.filter->project(payload, projected_)) payload = projected_;
+  }
+  feed_.feed_input(f.input, payload, f.seq ? f.seq : counters.received);
+}
+
+void MonitorLoop::on_schedule(std::chrono::steady_clock::time_point now) {
+  // Counters on request or on schedule, also while no message comes.
+  if (options_.stats_requested()) publish_stats();
+  if (options_.stats_interval > 0 && now - last_stats_ > std::chrono::duration<double>(options_.stats_interval)) {
+    last_stats_ = now;
+    publish_stats();
+  }
+  if (options_.on_record && now - last_record_ > std::chrono::duration<double>(options_.record_interval)) {
+    last_record_ = now;
+    options_.on_record(stats_json());
+  }
+}
+
 void MonitorLoop::process(const std::vector<transport::Source*>& sources) {
   counters_.assign(sources.size(), transport::SeqCounters{});
   input_eos_.assign(sources.size(), false);
   for (auto& c : counters_) c.expect(options_.publishers);
+  last_stats_ = last_record_ = std::chrono::steady_clock::now();
+  if (feed_.reads_in_order()) return process_in_order(sources);
   transport::FrameQueue queue(options_.queue_capacity);
   Shutdown shutdown(queue, sources);
   for (size_t i = 0; i < sources.size(); ++i) {
@@ -124,7 +190,7 @@ void MonitorLoop::process(const std::vector<transport::Source*>& sources) {
 
   using clock = std::chrono::steady_clock;
   const auto idle_limit = std::chrono::duration<double>(options_.idle_timeout);
-  auto last_message = clock::now(), last_stats = clock::now(), last_record = clock::now();
+  auto last_message = clock::now();
   std::vector<transport::OwnedFrame> batch;
   size_t count = 0;
   for (;;) {
@@ -148,58 +214,66 @@ void MonitorLoop::process(const std::vector<transport::Source*>& sources) {
       last_message = now;
       if (first_at_ == 0) first_at_ = wall_now();
       for (size_t i = 0; i < count; ++i) {
-        const transport::OwnedFrame& f = batch[i];
-        transport::SeqCounters& counters = counters_[f.input];
-        if (f.eos) {
-          // Several publishers: the input ends when each has ended.
-          if (options_.sequence_numbers) counters.on_eos(f.seq, f.publisher);
-          input_eos_[f.input] = !options_.sequence_numbers ||
-                                (counters.all_ended() && counters.publishers() >= options_.publishers);
-          if (!eos_ && ended()) {
-            eos_ = true;
-            feed_.end_of_input();
-          }
-          continue;
-        }
-        std::string_view payload = f.payload;
-        if (options_.sequence_numbers) {
-          counters.on_seq(f.seq, f.publisher);
-        } else if (f.seq == 1 && payload.substr(0, io::kUtf8Bom.size()) == io::kUtf8Bom) {
-          // A file's byte-order mark, as `rvc check` treats it; on a line of
-          // its own it leaves a blank line, which is no message.
-          payload.remove_prefix(io::kUtf8Bom.size());
-          feed_.warn(io::LineError{1, 1, io::kBomStartWarning});
-          if (payload.find_first_not_of(" \t\r") == std::string_view::npos) continue;
-        }
-        if (!options_.sequence_numbers) ++counters.received;
-        if (options_.filter) {  // after loss accounting: a filtered message was not lost
-          std::string_view key = f.key;
-          if (key.empty() && f.input < options_.key_of_input.size()) key = options_.key_of_input[f.input];
-          if (!options_.filter->admits(key)) {
-            ++filtered_;
-            continue;
-          }
-          if (options_.filter->projecting() && options_.filter->project(payload, projected_)) payload = projected_;
-        }
-        feed_.feed_input(f.input, payload, f.seq ? f.seq : counters.received);
+        const transport::OwnedFrame& o = batch[i];
+        transport::Frame f;
+        f.payload = o.payload;
+        f.seq = o.seq;
+        f.eos = o.eos;
+        f.publisher = o.publisher;
+        f.input = o.input;
+        f.key = o.key;
+        handle(f);
       }
     }
-    // Counters on request or on schedule, also while no message comes.
-    if (options_.stats_requested()) publish_stats();
-    if (options_.stats_interval > 0 && now - last_stats > std::chrono::duration<double>(options_.stats_interval)) {
-      last_stats = now;
-      publish_stats();
-    }
-    if (options_.on_record && now - last_record > std::chrono::duration<double>(options_.record_interval)) {
-      last_record = now;
-      options_.on_record(stats_json());
-    }
+    on_schedule(now);
     if (eos_ && options_.exit_on_eos) {
       end_ = EndReason::EndOfStream;
       break;
     }
   }
   shutdown.now();
+}
+
+void MonitorLoop::process_in_order(const std::vector<transport::Source*>& sources) {
+  for (transport::Source* s : sources)
+    if (!s->pullable()) throw std::logic_error("inputs merged by stamp must be files");
+  using clock = std::chrono::steady_clock;
+  const auto idle_limit = std::chrono::duration<double>(options_.idle_timeout);
+  auto last_message = clock::now();
+  uint64_t frames = 0;
+  transport::Frame f;
+  for (;;) {
+    if (options_.stop_requested()) {
+      end_ = EndReason::Stopped;
+      break;
+    }
+    const int input = feed_.next_input();
+    if (input < 0) {
+      end_ = EndReason::EndOfStream;
+      break;
+    }
+    const transport::PullResult r = sources[static_cast<size_t>(input)]->pull(f);
+    const auto now = clock::now();
+    if (r == transport::PullResult::Wait) {  // stdin or a pipe with nothing yet
+      feed_.idle();
+      outputs_.idle();
+      if (options_.idle_timeout > 0 && now - last_message > idle_limit) {
+        end_ = EndReason::IdleTimeout;
+        break;
+      }
+      on_schedule(now);
+      continue;
+    }
+    if (r == transport::PullResult::End) {  // after its end-of-stream frame: cannot be asked for again
+      feed_.input_ended(static_cast<uint32_t>(input));
+      continue;
+    }
+    last_message = now;
+    if (first_at_ == 0) first_at_ = wall_now();
+    f.input = static_cast<uint32_t>(input);
+    handle(f);
+    if ((++frames & 1023) == 0) on_schedule(now);
+  }
 }
 
 Outcome MonitorLoop::run(const std::vector<transport::Source*>& sources) {
@@ -229,10 +303,11 @@ Outcome MonitorLoop::run(const std::vector<transport::Source*>& sources) {
   outcome.violated = feed_.violations() > 0;
   outcome.lost = total(&transport::SeqCounters::gaps) > 0 || total(&transport::SeqCounters::duplicates) > 0;
   outcome.rejected = feed_.stats().rejected > 0;
+  outcome.dropped = feed_.lost() > 0;
   // Not a pass: nothing arrived at all, or (when the run was meant to end at
   // the publisher's end-of-stream marker) it ended some other way.
   if (end_ != EndReason::Failed) {
-    if (total(&transport::SeqCounters::received) == 0 && !eos_) {
+    if (total(&transport::SeqCounters::received) == 0) {
       std::fprintf(stderr, "rvc: nothing was received on %s (ended by %s): nothing was checked\n",
                    options_.input.c_str(), to_string(end_));
       outcome.incomplete = true;
@@ -246,6 +321,9 @@ Outcome MonitorLoop::run(const std::vector<transport::Source*>& sources) {
     } else if (options_.exit_on_eos && !eos_) {
       std::fprintf(stderr, "rvc: %s ended by %s before the publisher's end-of-stream marker: the stream is incomplete\n",
                    options_.input.c_str(), to_string(end_));
+      outcome.incomplete = true;
+    } else if (feed_.stats().accepted == 0) {
+      std::fprintf(stderr, "rvc: nothing was checked: %s\n", nothing_checked(feed_, filtered_).c_str());
       outcome.incomplete = true;
     }
   }

@@ -51,6 +51,10 @@ struct LoopOptions {
   std::function<bool()> stats_requested = [] { return false; };  // e.g. SIGUSR1 seen (true once)
 };
 
+// Why a run checked nothing, for its message: "3 messages received, 0
+// rejected, dropped {"unmatched":3}".
+std::string nothing_checked(const Feed& feed, uint64_t filtered = 0);
+
 // Why the loop ended.
 enum class EndReason { EndOfStream, Stopped, IdleTimeout, SourceClosed, Failed };
 const char* to_string(EndReason reason);
@@ -78,6 +82,12 @@ class MonitorLoop {
  private:
   void publish_stats();
   void process(const std::vector<transport::Source*>& sources);
+  // Files merged by stamp (Feed::reads_in_order): read on this thread, each
+  // the next message of the input the feed asks for.
+  void process_in_order(const std::vector<transport::Source*>& sources);
+  void handle(const transport::Frame& frame);  // one frame of either path
+  // Counters on request or on schedule; false once the run should end.
+  void on_schedule(std::chrono::steady_clock::time_point now);
   bool ended() const;  // every input's publishers sent their end-of-stream markers
   uint64_t total(uint64_t transport::SeqCounters::*field) const;
 
@@ -92,6 +102,7 @@ class MonitorLoop {
   std::string final_stats_;
   uint64_t filtered_ = 0;   // messages the filter kept from the monitor
   std::string projected_;   // the message as the filter projected it
+  std::chrono::steady_clock::time_point last_stats_{}, last_record_{};
   double first_at_ = 0;  // wall clock of the first message (benchmarks compare across processes)
 };
 

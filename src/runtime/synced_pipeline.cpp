@@ -1,5 +1,6 @@
 #include "runtime/synced_pipeline.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -25,17 +26,35 @@ struct SyncedPipeline::Input {
   std::vector<std::pair<int, int>> slots;  // (checker atom id, this input's atom id)
   InputCounters counters;
   std::string last_text;  // its latest set member as JSON (rvc sync)
+  // Ordered inputs (SyncOptions::ordered): its next message, decoded and
+  // waiting for the merge by stamp; whether it has ended; its last stamp.
+  bool has_pending = false, ended = false, any_stamp = false;
+  bool excluded = false;  // the merge no longer waits for it (silent, or ended)
+  sync::Member pending;
+  double last_stamp = 0;
+  std::string position_name;  // "input gear line", "input gear seq": names its messages
+  std::string pipeline_position(uint64_t position) const { return position_name + " " + std::to_string(position); }
 };
 
 // A message between arrival and release.
 struct SyncedPipeline::Held {
   uint32_t input = 0;
   bool used = false;
+  double stamp = 0;       // its own stamp (a late message checked with --late process goes out later)
+  uint64_t position = 0;  // its line or sequence number, for messages about it
   std::vector<uint8_t> values;  // in the input's atom order
   std::string text;             // as JSON, only when sets are published
 };
 
 namespace {
+
+constexpr uint64_t kLateShown = 10;  // late messages named one by one; the rest are counted
+
+std::string stamp_text(double stamp) {
+  std::string s;
+  io::append_number(s, stamp);
+  return s;
+}
 
 double wall_now() {
   return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
@@ -152,6 +171,7 @@ SyncedPipeline::SyncedPipeline(const std::vector<engine::PropertySpec>& properti
     po.time_field = in.arrival_stamp ? "time" : stamp;
     po.type = in.spec.type;
     po.position_name = "input " + in.spec.name + " " + options.position_name;
+    in.position_name = po.position_name;
     po.input_name = in.spec.name;
     if (in.spec.type) bind_message_type(*in.atoms, properties, *in.spec.type, dense, po.time_field, in.spec.name);
     const auto input = static_cast<uint32_t>(k);
@@ -211,8 +231,21 @@ void SyncedPipeline::feed_at(uint32_t input, std::string_view payload, uint64_t 
 // A message the input's decoder accepted: held under a token until the
 // policy releases it.
 void SyncedPipeline::accept(uint32_t input, const uint8_t* values, double time, uint64_t position) {
-  (void)position;
   Input& in = inputs_[input];
+  const double stamp = in.arrival_stamp ? arrival_ : time;
+  if (sync_.ordered) {
+    // Files are merged by stamp, so each must be in stamp order: a stamp that
+    // goes back is this line's fault, and refused here with its line.
+    if (in.any_stamp && stamp < in.last_stamp) {
+      ++in.counters.out_of_order;
+      report(in.pipeline_position(position) + ": stamp " + stamp_text(stamp) +
+             " is before the previous message's " + stamp_text(in.last_stamp) +
+             " (several files are merged by stamp: each must be in stamp order); message skipped");
+      return;
+    }
+    in.any_stamp = true;
+    in.last_stamp = stamp;
+  }
   uint32_t token;
   if (free_.empty()) {
     token = static_cast<uint32_t>(held_.size());
@@ -224,6 +257,8 @@ void SyncedPipeline::accept(uint32_t input, const uint8_t* values, double time, 
   Held& h = held_[token];
   h.input = input;
   h.used = false;
+  h.stamp = stamp;
+  h.position = position;
   h.values.assign(values, values + in.atoms->size());
   h.text.clear();
   if (on_set_) {
@@ -235,7 +270,77 @@ void SyncedPipeline::accept(uint32_t input, const uint8_t* values, double time, 
     }
   }
   ++in.counters.decoded;
-  policy_->add(sync::Member{input, in.arrival_stamp ? arrival_ : time, token});
+  if (in.excluded && !in.ended) {  // back after a silence: the merge waits for it again
+    in.excluded = false;
+    in.counters.reported_dead = false;  // a second silence is reported again
+    policy_->exclude(input, false);
+  }
+  const sync::Member member{input, stamp, token};
+  if (sync_.ordered) {
+    in.pending = member;
+    in.has_pending = true;
+    return;
+  }
+  policy_->add(member);
+}
+
+// The k-way merge of ordered inputs: while every input that has not ended
+// has its next message decoded, the earliest of those goes to the policy
+// (ties: the lower input); otherwise the first input without one is read.
+int SyncedPipeline::next_input() {
+  for (;;) {
+    int earliest = -1;
+    for (size_t i = 0; i < inputs_.size(); ++i) {
+      const Input& in = inputs_[i];
+      if (!in.ended && !in.has_pending) return static_cast<int>(i);
+      if (in.has_pending && (earliest < 0 || in.pending.stamp < inputs_[earliest].pending.stamp))
+        earliest = static_cast<int>(i);
+    }
+    if (earliest < 0) return -1;
+    inputs_[earliest].has_pending = false;
+    policy_->add(inputs_[earliest].pending);
+  }
+}
+
+void SyncedPipeline::input_ended(uint32_t input) {
+  if (input >= inputs_.size()) return;
+  inputs_[input].ended = true;
+  inputs_[input].excluded = true;  // nothing more will come: do not wait for it
+  policy_->exclude(input, true);
+}
+
+uint64_t SyncedPipeline::received() const {
+  uint64_t n = 0;
+  for (const Input& in : inputs_) n += in.counters.received;
+  return n;
+}
+
+void SyncedPipeline::add_dropped(io::JsonObject& out) const {
+  for (size_t r = 0; r < sync::kReleaseKinds; ++r) {
+    if (r == static_cast<size_t>(sync::Release::Used)) continue;
+    uint64_t n = 0;
+    for (const Input& in : inputs_) n += in.counters.released[r];
+    if (n) out.add(sync::to_string(static_cast<sync::Release>(r)), n);
+  }
+}
+
+// Late messages: the first few named with their input, position and stamp,
+// all counted, and a summary at the end (finish_report).
+void SyncedPipeline::report_late(const sync::Member& message, double after, bool checked, bool replaced) {
+  const Held& h = held_[message.token];
+  if (late_reported_++ >= std::min<uint64_t>(options_.max_reported, kLateShown)) return;
+  if (replaced) {
+    std::fprintf(stderr,
+                 "rvc: warning: %s: stamp %s: dropped, replaced by the input's next message with the same stamp (merge "
+                 "keeps one message per input and stamp)\n",
+                 inputs_[message.input].pipeline_position(h.position).c_str(), stamp_text(h.stamp).c_str());
+    return;
+  }
+  std::fprintf(stderr, "rvc: warning: %s: stamp %s came after the event at %s was checked: %s\n",
+               inputs_[message.input].pipeline_position(h.position).c_str(), stamp_text(h.stamp).c_str(),
+               stamp_text(after).c_str(),
+               checked ? "checked late, as the next event (--late process)"
+                       : "dropped as late (--late process checks such messages; --max-delay S waits longer)");
 }
 
 void SyncedPipeline::on_set(const sync::Member* members, size_t count, double set_stamp) {
@@ -254,6 +359,11 @@ void SyncedPipeline::on_set(const sync::Member* members, size_t count, double se
   for (size_t m = 0; m < count; ++m) {
     Held& h = held_[members[m].token];
     Input& in = inputs_[members[m].input];
+    if (sync_.policy == sync::PolicyKind::Merge && h.stamp < set_stamp) {  // late, checked (--late process)
+      ++in.counters.late_checked;
+      ++late_checked_;
+      report_late(members[m], has_time_ ? last_time_ : set_stamp, true, false);
+    }
     for (const auto& [global, local] : in.slots) combined_[global] = h.values[local];
     if (!h.used) {
       h.used = true;
@@ -277,6 +387,13 @@ void SyncedPipeline::on_set(const sync::Member* members, size_t count, double se
 
 void SyncedPipeline::on_release(const sync::Member& message, sync::Release why) {
   ++inputs_[message.input].counters.released[static_cast<size_t>(why)];
+  // merge drops nothing by design: a message it cannot check (late, or
+  // replaced by its input's next one at the same stamp) is a loss, warned
+  // and reflected in the exit status. The other policies drop by design.
+  if (why == sync::Release::Late || (why == sync::Release::Replaced && sync_.policy == sync::PolicyKind::Merge)) {
+    ++late_dropped_;
+    report_late(message, last_time_, false, why == sync::Release::Replaced);
+  }
   held_[message.token].text.clear();
   free_.push_back(static_cast<uint32_t>(message.token));
 }
@@ -291,8 +408,11 @@ void SyncedPipeline::check_health(double now) {
     if (in.counters.reported_dead || (in.counters.received && silent <= sync_.dead_after)) continue;
     if (!in.counters.received && now - first_arrival_ <= sync_.dead_after) continue;
     in.counters.reported_dead = true;
+    // Do not hold the others' messages for it any longer (merge).
+    in.excluded = true;
+    policy_->exclude(static_cast<uint32_t>(&in - inputs_.data()), true);
     std::string what = sync_.policy == sync::PolicyKind::Merge
-                           ? "its fields hold their last values"
+                           ? "its fields hold their last values, and the others' messages no longer wait for it"
                            : std::string("no ") + sync::to_string(sync_.policy) + " set can form without it";
     std::fprintf(stderr, "rvc: warning: input '%s' (%s): %s while the others deliver: %s\n", in.spec.name.c_str(),
                  in.spec.uri.c_str(),
@@ -316,6 +436,10 @@ void SyncedPipeline::idle() {
 void SyncedPipeline::end_of_input() {
   if (ended_) return;
   ended_ = true;
+  if (sync_.ordered) {  // what the merge by stamp still holds, in order
+    for (Input& in : inputs_) in.ended = true;
+    next_input();
+  }
   policy_->finish();
 }
 
@@ -326,12 +450,35 @@ void SyncedPipeline::finish_report() {
   if (reported_ > options_.max_reported)
     std::fprintf(stderr, "rvc: %llu more errors were not shown\n",
                  static_cast<unsigned long long>(reported_ - options_.max_reported));
+  if (late_dropped_ + late_checked_ == 0) return;
+  auto per_input = [&](bool checked) {
+    std::string s;
+    for (const Input& in : inputs_) {
+      const auto& r = in.counters.released;
+      const uint64_t n = checked ? in.counters.late_checked
+                                 : r[static_cast<size_t>(sync::Release::Late)] +
+                                       (sync_.policy == sync::PolicyKind::Merge ? r[static_cast<size_t>(sync::Release::Replaced)] : 0);
+      if (n) s += (s.empty() ? "" : ", ") + in.spec.name + ": " + std::to_string(n);
+    }
+    return s;
+  };
+  if (late_dropped_)
+    std::fprintf(stderr,
+                 "rvc: warning: %llu message%s dropped, not checked (%s): late (stamped before events already "
+                 "checked; --late process checks them, --max-delay S waits longer) or replaced (a repeated stamp)\n",
+                 static_cast<unsigned long long>(late_dropped_), late_dropped_ == 1 ? "" : "s",
+                 per_input(false).c_str());
+  if (late_checked_)
+    std::fprintf(stderr, "rvc: warning: %llu late message%s checked as the next event (%s)\n",
+                 static_cast<unsigned long long>(late_checked_), late_checked_ == 1 ? "" : "s",
+                 per_input(true).c_str());
 }
 
 const PipelineStats& SyncedPipeline::stats() const {
-  stats_ = PipelineStats{sets_, sets_rejected_, 0};
+  stats_ = PipelineStats{0, sets_rejected_, 0};
   for (const Input& in : inputs_) {
-    stats_.rejected += in.pipeline->stats().rejected;
+    stats_.accepted += in.counters.used;
+    stats_.rejected += in.pipeline->stats().rejected + in.counters.out_of_order;
     stats_.warnings += in.pipeline->stats().warnings;
   }
   return stats_;
@@ -350,9 +497,10 @@ void SyncedPipeline::add_stats(io::JsonObject& out) const {
     o.add("name", in.spec.name)
         .add("uri", in.spec.uri)
         .add("received", c.received)
-        .add("rejected", in.pipeline->stats().rejected)
+        .add("rejected", in.pipeline->stats().rejected + c.out_of_order)
         .add("used", c.used)
         .add("dropped", dropped);
+    if (c.late_checked) o.add("late_checked", c.late_checked);
     if (c.received) o.add_fixed("silent_s", now - c.last_arrival, 3);
     per_input.add(o);
   }

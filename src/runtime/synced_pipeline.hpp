@@ -42,6 +42,11 @@ struct SyncOptions {
   sync::PolicyKind policy = sync::PolicyKind::Merge;
   sync::PolicyOptions policy_options;  // `inputs` is filled in
   double dead_after = 5;               // seconds: an input silent this long while others deliver is reported
+  // The inputs are files, read by the caller in the order next_input() asks
+  // for: a k-way merge by stamp, one message ahead per input, so the sets do
+  // not depend on which file a thread happened to read faster. A file whose
+  // stamps go back is refused at that line (each file must be in order).
+  bool ordered = false;
 };
 
 // One set as JSON: {"time": stamp, "gear": {...}, "steer": {...}}, every
@@ -67,8 +72,15 @@ class SyncedPipeline final : public Feed, private sync::Handler {
   void warn(const io::LineError& warning) override;
   void idle() override;
   void end_of_input() override;
-  // accepted: sets checked; rejected: messages the inputs refused plus sets
-  // out of time order; warnings: the inputs'.
+  bool reads_in_order() const override { return sync_.ordered; }
+  int next_input() override;
+  void input_ended(uint32_t input) override;
+  uint64_t received() const override;
+  void add_dropped(io::JsonObject& out) const override;
+  uint64_t lost() const override { return late_dropped_; }
+  // accepted: messages in a checked set; rejected: messages the inputs
+  // refused (out of order ones too) plus sets out of time order; warnings:
+  // the inputs'.
   const PipelineStats& stats() const override;
   uint64_t violations() const override { return checker_.violations(); }
   void finish_report() override;
@@ -86,6 +98,8 @@ class SyncedPipeline final : public Feed, private sync::Handler {
     uint64_t decoded = 0;   // messages that went to the policy
     uint64_t used = 0;      // messages that were in a set
     std::array<uint64_t, sync::kReleaseKinds> released{};  // by Release
+    uint64_t out_of_order = 0;  // ordered inputs: refused, stamped before the input's previous message
+    uint64_t late_checked = 0;  // merge, --late process: late messages checked as the next event
     double last_arrival = 0;
     bool reported_dead = false;
   };
@@ -99,6 +113,7 @@ class SyncedPipeline final : public Feed, private sync::Handler {
   void accept(uint32_t input, const uint8_t* values, double time, uint64_t position);
   void check_health(double now);
   void report(const std::string& text);
+  void report_late(const sync::Member& message, double after, bool checked, bool replaced);
 
   engine::Checker checker_;
   PipelineOptions options_;
@@ -112,6 +127,8 @@ class SyncedPipeline final : public Feed, private sync::Handler {
   mutable PipelineStats stats_;
   double first_arrival_ = 0;
   uint64_t sets_ = 0, sets_rejected_ = 0, reported_ = 0;
+  uint64_t late_dropped_ = 0;  // lost: dropped late, or (merge) replaced by a message at the same stamp
+  uint64_t late_checked_ = 0, late_reported_ = 0;
   bool has_time_ = false, ended_ = false;
   double last_time_ = 0;
   uint32_t feeding_ = 0;           // the input whose payload is being decoded

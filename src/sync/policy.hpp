@@ -80,9 +80,26 @@ struct PolicyOptions {
   // approximate: per input, the least time between two of its messages
   // (seconds; empty or 0: unknown). Lets a set out sooner.
   std::vector<double> inter_message_lower_bound;
-  // merge: a message is released once a message stamped more than max_delay
-  // after it has arrived (or by advance()/finish()).
+  // merge: a message is released once a message stamped more than the delay
+  // after it has arrived (or by advance()/finish()). The delay starts at
+  // max_delay; with adaptive_limit > 0 it grows to twice the largest lateness
+  // seen (how far behind the newest stamp a message arrived), at most to
+  // adaptive_limit: ordinary jitter stops making messages late after the
+  // first, and each further late message at least doubles the delay.
   double max_delay = 0;
+  double adaptive_limit = 0;
+  // merge: a late message (at or before the last set out) is not dropped but
+  // released as a set of its own, stamped just after that set (the least
+  // double above it): checked as the next event, since the events after its
+  // own stamp have been checked already.
+  bool process_late = false;
+  // merge: also wait for every input: a stamp goes out only once each input
+  // not excluded (exclude(): silent, ended) has delivered a later one. Each
+  // input is in stamp order itself, so publishers that start or run apart do
+  // not make each other's messages late. max_held bounds what this may hold:
+  // past it the earliest goes out regardless.
+  bool wait_for_inputs = false;
+  size_t max_held = std::numeric_limits<size_t>::max();
   // latest: the input whose messages make sets; -1: the fastest so far
   // (smallest mean interval between its stamps; ties: the lower input).
   int pivot = -1;
@@ -98,6 +115,12 @@ class Policy {
   // new messages (a caller whose stamps follow a clock calls this while idle).
   // Others: no effect.
   virtual void advance(double stamp) { (void)stamp; }
+  // merge with wait_for_inputs: stop (or start again) waiting for an input,
+  // e.g. one that has gone silent or has ended. Others: no effect.
+  virtual void exclude(uint32_t input, bool excluded) {
+    (void)input;
+    (void)excluded;
+  }
   // End of stream: merge releases what it holds as sets in stamp order; the
   // others release what they hold as Unfinished (latest: Used if a set used it).
   // The policy is then empty, as new, and may take another stream.

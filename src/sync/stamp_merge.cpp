@@ -84,21 +84,59 @@ void StampMerge::StampIndex::clear() {
 // ---- the policy ----
 
 StampMerge::StampMerge(const PolicyOptions& options, Handler& handler)
-    : handler_(handler), n_(static_cast<uint32_t>(options.inputs)), max_delay_(options.max_delay), newest_(-kInf) {
+    : handler_(handler),
+      n_(static_cast<uint32_t>(options.inputs)),
+      max_delay_(options.max_delay),
+      adaptive_limit_(options.adaptive_limit),
+      process_late_(options.process_late),
+      wait_for_inputs_(options.wait_for_inputs),
+      max_held_(std::max<size_t>(options.max_held, 1)),
+      delay_(options.max_delay),
+      newest_(-kInf) {
   if (options.inputs == 0 || options.inputs > std::numeric_limits<uint32_t>::max())
     throw std::invalid_argument("merge: the number of inputs must be positive");
   if (!(max_delay_ >= 0)) throw std::invalid_argument("merge: max_delay must be >= 0");
+  if (!(adaptive_limit_ >= 0)) throw std::invalid_argument("merge: adaptive_limit must be >= 0");
   newest_of_.assign(n_, -kInf);
+  excluded_.assign(n_, 0);
   members_.reserve(n_);
 }
 
-void StampMerge::add(const Member& message) {
-  if (message.input >= n_) throw std::out_of_range("merge: input out of range");
-  const double stamp = message.stamp;
-  if (!std::isfinite(stamp) || (any_set_ && stamp <= last_set_)) {
-    handler_.on_release(message, Release::Late);
+double StampMerge::watermark() const {
+  const double delayed = newest_ - delay_;
+  if (!wait_for_inputs_) return delayed;
+  double slowest = kInf;
+  for (uint32_t i = 0; i < n_; ++i)
+    if (!excluded_[i]) slowest = std::min(slowest, newest_of_[i]);
+  return std::min(slowest, delayed);
+}
+
+void StampMerge::exclude(uint32_t input, bool excluded) {
+  if (input >= n_) return;
+  excluded_[input] = excluded;
+  release_below(watermark());
+}
+
+void StampMerge::add(const Member& arrived) {
+  if (arrived.input >= n_) throw std::out_of_range("merge: input out of range");
+  if (!std::isfinite(arrived.stamp)) {
+    handler_.on_release(arrived, Release::Late);
     return;
   }
+  // Adapt: a message behind the newest stamp shows how late this stream's
+  // messages come; wait twice that from now on (up to the limit).
+  if (adaptive_limit_ > 0 && arrived.stamp < newest_)
+    delay_ = std::max(delay_, std::min(2 * (newest_ - arrived.stamp), std::max(adaptive_limit_, max_delay_)));
+  Member message = arrived;
+  const bool late = any_set_ && message.stamp <= last_set_;
+  if (late) {
+    if (!process_late_) {
+      handler_.on_release(message, Release::Late);
+      return;
+    }
+    message.stamp = std::nextafter(last_set_, kInf);  // the next event, before everything held
+  }
+  const double stamp = message.stamp;
   const uint64_t key = stamp_key(stamp);
   uint32_t g = index_.find(key);
   if (g == kNone) {
@@ -140,12 +178,20 @@ void StampMerge::add(const Member& message) {
   }
   if (stamp > newest_of_[message.input]) newest_of_[message.input] = stamp;
   if (stamp > newest_) newest_ = stamp;
-  release_below(newest_ - max_delay_);
+  // A late message goes out at once: its group is the earliest held (every
+  // other stamp held is above the last set's), and a second late message of
+  // its input must not find it still held and replace it.
+  if (late) release_top();
+  else release_below(watermark());
+  while (held_ > max_held_) release_top();  // memory bound: the earliest goes, later ones of it may be late
 }
 
 void StampMerge::advance(double stamp) {
   if (stamp > newest_) newest_ = stamp;  // NaN compares false: ignored
-  release_below(newest_ - max_delay_);
+  // Stamps that follow a clock: no input can still deliver an earlier one.
+  for (double& n : newest_of_)
+    if (stamp > n) n = stamp;
+  release_below(watermark());
 }
 
 void StampMerge::release_below(double watermark) {
@@ -180,6 +226,8 @@ void StampMerge::finish() {
   index_.clear();
   newest_of_.assign(n_, -kInf);
   newest_ = -kInf;
+  delay_ = max_delay_;
+  excluded_.assign(n_, 0);
   any_set_ = false;
 }
 

@@ -4,7 +4,9 @@
 // messages of different inputs at one stamp leave together as one set (at
 // most one per input; a second message of an input at a stamp replaces the
 // first, Replaced). A message at or before the last set's stamp is Late: it
-// would break the order of the events.
+// would break the order of the events (options.process_late: it becomes a set
+// of its own, just after that one). The delay may adapt to the lateness seen
+// (PolicyOptions::adaptive_limit).
 //
 // Pending stamps are groups in a binary heap keyed by stamp (O(log n) per
 // message) and in an open-addressing hash from stamp to group, which finds
@@ -22,13 +24,15 @@ namespace rvc::sync {
 
 class StampMerge final : public Policy {
  public:
-  // Throws std::invalid_argument on inputs == 0 or a negative (or NaN) max_delay.
+  // Throws std::invalid_argument on inputs == 0 or a negative (or NaN) max_delay or adaptive_limit.
   StampMerge(const PolicyOptions& options, Handler& handler);
 
   void add(const Member& message) override;
   void advance(double stamp) override;
+  void exclude(uint32_t input, bool excluded) override;
   void finish() override;
   size_t held() const override { return held_; }
+  double delay() const { return delay_; }  // the watermark's delay now (adapted)
 
  private:
   static constexpr uint32_t kNone = UINT32_MAX;
@@ -57,11 +61,18 @@ class StampMerge final : public Policy {
   };
 
   void release_below(double watermark);
+  double watermark() const;  // stamps below it go out
   void release_top();
 
   Handler& handler_;
   const uint32_t n_;
   const double max_delay_;
+  const double adaptive_limit_;
+  const bool process_late_;
+  const bool wait_for_inputs_;
+  const size_t max_held_;
+  std::vector<uint8_t> excluded_;  // wait_for_inputs: inputs not waited for
+  double delay_;  // max_delay_, grown by adaptation
   std::vector<Node> nodes_;
   uint32_t free_node_ = kNone;
   std::vector<Group> groups_;

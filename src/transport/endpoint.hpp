@@ -16,6 +16,10 @@
 
 namespace rvc::transport {
 
+// What Source::pull found: a frame, nothing yet (a pipe that is quiet: ask
+// again), or nothing more after the end-of-stream frame.
+enum class PullResult { Frame, Wait, End };
+
 class Source {
  public:
   virtual ~Source() = default;
@@ -24,6 +28,15 @@ class Source {
   virtual void start(FrameHandler handler) = 0;
   // Stops delivery; no handler call is running or will run after it returns.
   virtual void stop() = 0;
+  // Sources the caller can read on its own thread, one frame when it wants
+  // it, instead of start() (files): several are then read in the order the
+  // caller chooses, not raced by threads. The frame's payload stays valid
+  // until the next pull. Waits at most about 100 ms for data.
+  virtual bool pullable() const { return false; }
+  virtual PullResult pull(Frame& frame) {
+    (void)frame;
+    return PullResult::End;
+  }
 };
 
 class Sink {

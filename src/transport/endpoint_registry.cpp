@@ -72,6 +72,15 @@ bool endpoints_overlap(const std::string& a, const std::string& b) {
 #endif
 }
 
+bool reads_back(const std::string& input, const std::string& output) {
+  if (endpoints_overlap(input, output)) return true;
+  const Parsed in = parse(input), out = parse(output);
+  if (in.scheme != "file" || in.rest != "-" || out.scheme != "file" || out.rest == "-") return false;
+  struct stat si, so;
+  if (::fstat(0, &si) != 0 || ::stat(out.rest.c_str(), &so) != 0) return false;
+  return S_ISREG(si.st_mode) && si.st_dev == so.st_dev && si.st_ino == so.st_ino;
+}
+
 std::unique_ptr<Source> open_source(const std::string& uri, const TransportOptions& options) {
   Parsed p = parse(uri);
   if (p.scheme == "mcap")  // read whole by the runtime (runtime/check_bag.hpp), not as a stream

@@ -26,54 +26,76 @@ void FileSource::start(FrameHandler handler) {
 }
 
 void FileSource::read_all(const FrameHandler& handler) {
-  std::string buf;       // bytes read, not yet split into lines
-  size_t scanned = 0;    // buf[0, scanned) holds no newline
-  uint64_t line = 0;
-  auto deliver = [&](size_t begin, size_t end) {
-    size_t len = end - begin;
-    while (len > 0 && buf[begin + len - 1] == '\r') --len;
-    ++line;
-    // Blank lines (nothing, or only spaces, tabs and CRs) are not messages,
-    // as in `rvc check`.
-    std::string_view text(buf.data() + begin, len);
-    if (text.find_first_not_of(" \t\r") != std::string_view::npos) {
-      Frame f;
-      f.payload = text;
-      f.seq = line;
-      handler(f);
-    }
-  };
-  char chunk[1 << 16];
+  Frame f;
   for (;;) {
     if (stop_.load(std::memory_order_relaxed)) return;
-    pollfd p{fd_, POLLIN, 0};
-    int ready = ::poll(&p, 1, 100);  // wake up now and then to see stop()
-    if (ready < 0 && errno != EINTR) break;
-    if (ready <= 0) continue;
-    ssize_t n = ::read(fd_, chunk, sizeof chunk);
-    if (n < 0) {
-      if (errno == EINTR || errno == EAGAIN) continue;
-      break;  // a read error ends the input like its end would
-    }
-    if (n == 0) break;
-    buf.append(chunk, static_cast<size_t>(n));
-    size_t begin = 0;
-    for (;;) {
-      const void* nl = std::memchr(buf.data() + scanned, '\n', buf.size() - scanned);
-      if (!nl) break;
-      size_t end = static_cast<size_t>(static_cast<const char*>(nl) - buf.data());
-      deliver(begin, end);
-      begin = scanned = end + 1;
-    }
-    buf.erase(0, begin);
-    scanned = buf.size();
+    const PullResult r = pull(f);
+    if (r == PullResult::End) return;
+    if (r == PullResult::Wait) continue;  // pull waited ~100 ms: look at stop_ again
+    if (f.eos && stop_.load()) return;
+    handler(f);
+    if (f.eos) return;
   }
-  if (!buf.empty()) deliver(0, buf.size());  // a last line without its newline
-  if (!stop_.load()) {
-    Frame eos;
-    eos.seq = line;
-    eos.eos = true;
-    handler(eos);
+}
+
+bool FileSource::line_frame(size_t begin, size_t end, Frame& f) {
+  size_t len = end - begin;
+  while (len > 0 && buf_[begin + len - 1] == '\r') --len;
+  ++line_;
+  // Blank lines (nothing, or only spaces, tabs and CRs) are not messages,
+  // as in `rvc check`.
+  std::string_view text(buf_.data() + begin, len);
+  if (text.find_first_not_of(" \t\r") == std::string_view::npos) return false;
+  f = Frame{};
+  f.payload = text;
+  f.seq = line_;
+  return true;
+}
+
+PullResult FileSource::pull(Frame& f) {
+  for (;;) {
+    if (const void* nl = std::memchr(buf_.data() + scanned_, '\n', buf_.size() - scanned_)) {
+      const size_t end = static_cast<size_t>(static_cast<const char*>(nl) - buf_.data());
+      const size_t begin = begin_;
+      begin_ = scanned_ = end + 1;
+      if (line_frame(begin, end, f)) return PullResult::Frame;
+      continue;
+    }
+    scanned_ = buf_.size();
+    if (at_end_) {
+      if (begin_ < buf_.size()) {  // a last line without its newline
+        const size_t begin = begin_;
+        begin_ = scanned_ = buf_.size();
+        if (line_frame(begin, buf_.size(), f)) return PullResult::Frame;
+      }
+      if (eos_sent_) return PullResult::End;
+      eos_sent_ = true;
+      f = Frame{};
+      f.seq = line_;
+      f.eos = true;
+      return PullResult::Frame;
+    }
+    // More bytes are needed: drop what was delivered (the frame returned by
+    // the previous pull goes with it), then wait for the next chunk.
+    buf_.erase(0, begin_);
+    scanned_ -= begin_;
+    begin_ = 0;
+    pollfd p{fd_, POLLIN, 0};
+    const int ready = ::poll(&p, 1, 100);  // wake up now and then: the caller may want to stop
+    if (ready < 0 && errno != EINTR) {
+      at_end_ = true;  // a read error ends the input like its end would
+      continue;
+    }
+    if (ready <= 0) return PullResult::Wait;
+    char chunk[1 << 16];
+    const ssize_t n = ::read(fd_, chunk, sizeof chunk);
+    if (n < 0) {
+      if (errno == EINTR || errno == EAGAIN) return PullResult::Wait;
+      at_end_ = true;
+      continue;
+    }
+    if (n == 0) at_end_ = true;
+    else buf_.append(chunk, static_cast<size_t>(n));
   }
 }
 

@@ -1,6 +1,7 @@
 // file:PATH endpoints: JSON lines. As a source, each non-blank line is one
 // frame (seq = line number) followed by an end-of-stream frame at the end of
-// the file; as a sink, each payload is written as one line.
+// the file, delivered by a thread of its own (start) or one by one to the
+// caller (pull); as a sink, each payload is written as one line.
 #pragma once
 
 #include <atomic>
@@ -21,12 +22,20 @@ class FileSource final : public Source {
   // Returns promptly even while the reader waits for input that never comes
   // (stdin, a pipe): the reader polls and checks the flag between waits.
   void stop() override;
+  bool pullable() const override { return true; }
+  PullResult pull(Frame& frame) override;
 
  private:
   void read_all(const FrameHandler& handler);
+  bool line_frame(size_t begin, size_t end, Frame& frame);  // false: a blank line, no frame
 
   std::string path_;
   int fd_ = -1;
+  std::string buf_;       // bytes read: buf_[begin_, size) not yet delivered
+  size_t begin_ = 0;
+  size_t scanned_ = 0;    // buf_[begin_, scanned_) holds no newline
+  uint64_t line_ = 0;
+  bool at_end_ = false, eos_sent_ = false;
   std::thread reader_;
   std::atomic<bool> stop_{false};
 };

@@ -40,4 +40,11 @@ std::string scheme_of(const std::string& uri);
 // feed itself without end. Throws std::invalid_argument for a bad URI.
 bool endpoints_overlap(const std::string& a, const std::string& b);
 
+// Whether writing to `output` would change what `input` reads: the two
+// overlap, or the input is stdin ("-") redirected from the very file the
+// output names (`rvc check - -o t.jsonl < t.jsonl`: compared by device and
+// inode, so hard links and symlinks count too). Opening the output would
+// truncate the input before it is read. Throws as endpoints_overlap.
+bool reads_back(const std::string& input, const std::string& output);
+
 }  // namespace rvc::transport

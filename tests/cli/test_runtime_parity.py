@@ -87,13 +87,13 @@ def test_output_naming_the_input_is_refused(rvc, tmp_path):
 
 def test_empty_input_is_not_a_pass_for_monitor(rvc, tmp_path):
     # An empty file still ends with an end-of-stream marker: nothing was lost,
-    # but nothing was checked either.
+    # but nothing was checked either: incomplete (issue 25).
     trace = tmp_path / "empty.jsonl"
     trace.write_text("")
     m = run(rvc, "monitor", "--spec", "{p}", "--input", f"file:{trace}", "--output", f"file:{tmp_path / 'v'}")
     s = final_stats(m.stderr)
     assert s["received"] == 0 and s["eos"] is True
-    assert m.returncode == 0  # an empty file is a complete (empty) stream
+    assert m.returncode == 6 and "nothing was received" in m.stderr, m.stderr
 
 
 def test_blank_lines_in_a_file_are_not_lost_messages(rvc, tmp_path):

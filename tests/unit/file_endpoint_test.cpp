@@ -82,6 +82,33 @@ TEST(FileSource, LinesBlankLinesLongLinesAndTheEnd) {
   EXPECT_EQ(c.frames, (std::vector<F>{{1, "\xEF\xBB\xBF{\"a\":1}"}, {3, long_line}, {4, "{\"a\":2}"}, {4, "<eos>"}}));
 }
 
+// pull(): the same frames, one per call on the caller's thread (how several
+// files are read in stamp order); a quiet pipe says Wait, not End.
+TEST(FileSource, PullGivesTheSameFramesOnTheCallersThread) {
+  PipeSource p;
+  const std::string long_line = "{\"pad\":\"" + std::string(100000, 'x') + "\"}";
+  using F = std::pair<uint64_t, std::string>;
+  std::vector<F> frames;
+  Frame f;
+  ASSERT_TRUE(p.source().pullable());
+  EXPECT_EQ(p.source().pull(f), PullResult::Wait);  // nothing written yet
+  // Written by another thread: the pipe holds less than the long line.
+  std::thread writer([&] {
+    p.write("{\"a\":1}\r\n\n");
+    p.write(long_line.substr(0, 70000));
+    p.write(long_line.substr(70000) + "\n{\"a\":2}");
+    p.close_writer();
+  });
+  for (int i = 0; i < 1000; ++i) {
+    const PullResult r = p.source().pull(f);
+    if (r == PullResult::End) break;
+    if (r == PullResult::Frame) frames.emplace_back(f.seq, f.eos ? std::string("<eos>") : std::string(f.payload));
+  }
+  writer.join();
+  EXPECT_EQ(frames, (std::vector<F>{{1, "{\"a\":1}"}, {3, long_line}, {4, "{\"a\":2}"}, {4, "<eos>"}}));
+  EXPECT_EQ(p.source().pull(f), PullResult::End);
+}
+
 TEST(FileSink, WriteErrorsAreReported) {
   FileSink sink("/dev/full");
   // stdio buffers the first lines; the error shows at the latest on flush.
