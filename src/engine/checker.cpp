@@ -125,26 +125,33 @@ void Checker::step_robust(const double* margins) {
   }
 }
 
+void Checker::report_robust(size_t i, double time, double r) {
+  if (r == last_robustness_[i]) return;  // changes only, as for Booleans in dense time (emit_all too)
+  last_robustness_[i] = r;
+  const bool holds = r > 0;
+  if (!holds) ++violations_;
+  if (on_verdict_) on_verdict_(Verdict{names_[i], time, holds, true, r});
+}
+
 void Checker::step_robust(double begin, double end, const double* margins) {
+  if (begin < clock_) begin = clock_;  // a tick went there already
   if (!(begin < end)) return;
-  for (size_t i = 0; i < robust_dense_.size(); ++i) {
-    for (const robust::RealPiece& p : robust_dense_[i].step(begin, end, margins).pieces) {
-      if (p.v == last_robustness_[i]) continue;  // changes only, as for Booleans in dense time
-      last_robustness_[i] = p.v;
-      const bool holds = p.v > 0;
-      if (!holds) ++violations_;
-      if (on_verdict_) on_verdict_(Verdict{names_[i], p.t, holds, true, p.v});
-    }
-  }
+  clock_ = end;
+  for (size_t i = 0; i < robust_dense_.size(); ++i)
+    for (const robust::RealPiece& p : robust_dense_[i].step(begin, end, margins).pieces) report_robust(i, p.t, p.v);
 }
 
 void Checker::step(double begin, double end, const uint8_t* atoms, const uint32_t* bound) {
+  if (begin < clock_) begin = clock_;  // a tick went there already
   if (!(begin < end)) return;  // an empty segment has no value to report
+  clock_ = end;
+  const bool told = emit_all_ && begin == told_at_;  // a tick at begin reported its value: not twice
   for (size_t i = 0; i < where_.size(); ++i) {
     const auto [kind, k] = where_[i];
     const dense::Signal& s =
         kind == kData ? dense_data_[k].step(begin, end, atoms, bound) : dense_[k].step(begin, end, atoms);
     for (const dense::Piece& p : s.pieces) {
+      if (told && p.t == begin) continue;
       if (explain_ && !p.v && last_[i] != 0) {  // a violation starts at p.t: say why, from this segment's signals
         const std::vector<std::string> why =
             kind == kData ? dense_data_[k].explain(p.t, &value_names_) : dense_[k].explain(p.t);
@@ -154,6 +161,64 @@ void Checker::step(double begin, double end, const uint8_t* atoms, const uint32_
       }
     }
   }
+}
+
+bool Checker::value_at_clock(size_t i, const uint8_t* atoms, const uint32_t* bound) {
+  const auto [kind, k] = where_[i];
+  return kind == kData ? dense_data_[k].at(clock_, atoms, bound) : dense_[k].at(clock_, atoms);
+}
+
+void Checker::tick(double now, const uint8_t* atoms, const uint32_t* bound) {
+  if (model_ != TimeModel::Dense || !(now >= clock_)) return;  // behind the clock (or NaN): nothing to do
+  if (now > clock_) step(clock_, now, atoms, bound);
+  clock_ = now;
+  for (size_t i = 0; i < where_.size(); ++i) {
+    const bool v = value_at_clock(i, atoms, bound);
+    if (explain_ && !v && last_[i] != 0) {  // a violation starts at the tick: say why, from the values there
+      const auto [kind, k] = where_[i];
+      const std::vector<std::string> why =
+          kind == kData ? dense_data_[k].explain_at(now, &value_names_) : dense_[k].explain_at(now);
+      report(i, now, v, &why);
+    } else {
+      report(i, now, v);
+    }
+  }
+  told_at_ = now;
+}
+
+void Checker::tick_robust(double now, const double* margins) {
+  if (model_ != TimeModel::Dense || !(now >= clock_)) return;
+  if (now > clock_) step_robust(clock_, now, margins);
+  clock_ = now;
+  for (size_t i = 0; i < robust_dense_.size(); ++i) report_robust(i, now, robust_dense_[i].at(now, margins));
+  told_at_ = now;
+}
+
+double Checker::next_deadline(const uint8_t* atoms, const uint32_t* bound) {
+  constexpr double kNever = std::numeric_limits<double>::infinity();
+  if (model_ != TimeModel::Dense) return kNever;  // discrete time has no clock: steps are messages
+  double next = kNever;
+  for (size_t i = 0; i < where_.size(); ++i) {
+    const bool v = value_at_clock(i, atoms, bound);
+    if (emit_all_ ? told_at_ != clock_ : last_[i] != static_cast<int8_t>(v)) return clock_;  // not told yet
+    const auto [kind, k] = where_[i];
+    const double t = kind == kData ? dense_data_[k].next_change(clock_) : dense_[k].next_change(clock_);
+    if (t < next) next = t;
+  }
+  return next;
+}
+
+double Checker::next_deadline_robust(const double* margins) {
+  constexpr double kNever = std::numeric_limits<double>::infinity();
+  if (model_ != TimeModel::Dense) return kNever;
+  double next = kNever;
+  for (size_t i = 0; i < robust_dense_.size(); ++i) {
+    const double r = robust_dense_[i].at(clock_, margins);
+    if (!(r == last_robustness_[i])) return clock_;  // not told yet
+    const double t = robust_dense_[i].next_change(clock_);
+    if (t < next) next = t;
+  }
+  return next;
 }
 
 }  // namespace rvc::engine

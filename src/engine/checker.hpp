@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -80,10 +81,43 @@ class Checker {
   // Dense time: the atoms' values held over [begin, end).
   void step(double begin, double end, const uint8_t* atoms, const uint32_t* bound = nullptr);
 
+  // ---- Clock-driven monitoring (dense time; docs/semantics.md, "Ticks") ----
+  //
+  // A tick is an empty message: every field holds its value. tick(now, ...)
+  // closes [clock(), now) with the held values (verdict changes inside it are
+  // reported at their exact times, however late the tick comes) and then
+  // reports the value at `now` itself, which a message would only report
+  // with the segment after it. Verdicts are those of the same trace with a
+  // message repeating the last values at `now`; the next message (or tick)
+  // goes on from `now`. Ticks and deadlines cost nothing until called.
+  //
+  // The instant the monitors have reached: the end of the last step or tick
+  // (0 before any).
+  double clock() const { return clock_; }
+  // `atoms`/`bound`/`margins`: the values held since the last message (the
+  // decoder's committed values, as the next step() will be given). A tick
+  // before the clock does nothing; a tick at the clock only reports the
+  // value there (right after a message: its own verdict, without waiting
+  // for the next one). Throws data::DataLimitError as step() does.
+  void tick(double now, const uint8_t* atoms, const uint32_t* bound = nullptr);
+  void tick_robust(double now, const double* margins);
+  // When to tick next: the first instant >= clock() at which some verdict
+  // can change if the held values stay (the clock itself when the value
+  // there has not been reported yet); +inf when none can. Never later than
+  // the change; it may be earlier (a tick then reports nothing: ask again).
+  // From the operators' windows, O(operators) per call (data references:
+  // per table entry, as a step). The runtime calls it after every message
+  // and tick it makes, and sleeps until then (or until the next message).
+  double next_deadline(const uint8_t* atoms, const uint32_t* bound = nullptr);
+  double next_deadline_robust(const double* margins);
+
   uint64_t violations() const { return violations_; }  // verdicts reported false
 
  private:
   void report(size_t property, double time, bool value, const std::vector<std::string>* explanation = nullptr);
+  void report_robust(size_t property, double time, double robustness);
+  // Each property's value at the clock, the held values (tick, next_deadline).
+  bool value_at_clock(size_t property, const uint8_t* atoms, const uint32_t* bound);
 
   TimeModel model_;
   bool emit_all_;
@@ -109,6 +143,10 @@ class Checker {
   std::vector<double> last_robustness_;
   int64_t now_robust_ = 0;
   int64_t now_discrete_ = 0;
+  double clock_ = 0;  // dense time: where the last step or tick ended
+  // Dense time: the instant a tick last reported the value at (NaN: none).
+  // With emit_all, the step that starts there does not report it again.
+  double told_at_ = std::numeric_limits<double>::quiet_NaN();
   std::vector<int8_t> last_;  // last reported value per property, -1 before the first
   uint64_t violations_ = 0;
 };

@@ -26,6 +26,7 @@ class IntervalQueue {
   const Interval<T>& front() const { return buf_[head_]; }
   const Interval<T>& at(size_t i) const { return buf_[(head_ + i) & mask_]; }
   Interval<T>& back() { return buf_[(head_ + size_ - 1) & mask_]; }
+  const Interval<T>& back() const { return buf_[(head_ + size_ - 1) & mask_]; }
 
   // Appends [lo, hi], merging with the last interval when they touch.
   // `touch` says how close counts as touching: 1 for integer steps (closed

@@ -28,6 +28,16 @@ class DenseMonitor {
   // the property's value over it. Throws DataLimitError past max_values.
   const dense::Signal& step(double begin, double end, const uint8_t* atoms, const uint32_t* bound);
 
+  // Clock-driven monitoring (dense::Monitor::at, next_change, explain_at),
+  // per assignment: after a step that ended at `now`, the atoms and bound
+  // values held from there on, the property's value at `now` (a value bound
+  // for the first time joins the tables, as the next step would have it
+  // join: may throw DataLimitError); then the first time after `now` at
+  // which an entry of any operator can change. O(table entries), as a step.
+  bool at(double now, const uint8_t* atoms, const uint32_t* bound);
+  double next_change(double now) const;
+  std::vector<std::string> explain_at(double now, const explain::ValueNames* names = nullptr) const;
+
   // --explain: call before the first step, so the values met can be named.
   void enable_explain() { bindings_.keep_origins(); }
   // After step(): why the property has its value at time t of the segment
@@ -49,6 +59,7 @@ class DenseMonitor {
   std::vector<Table<dense::Historically>> historically_;
   std::vector<Table<dense::Since>> since_;
   dense::Signal scratch_;
+  std::vector<Table<uint8_t>> at_;  // at(): each sub-formula's values at the clock
 };
 
 }  // namespace rvc::engine::data

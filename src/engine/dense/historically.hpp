@@ -10,6 +10,10 @@ struct Historically {
   Once violations;
   Signal negated, scratch;
 
+  // Clock-driven monitoring: as Once::at and Once::next_change.
+  bool at(bool input, double now) const { return !violations.at(!input, now); }
+  double next_change(bool input, double now) const { return violations.next_change(!input, now); }
+
   void update(const Signal& input, double end, Signal& out) {
     negated.clear();
     for (const Piece& pc : input.pieces) negated.set(pc.t, !pc.v);

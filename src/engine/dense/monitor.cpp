@@ -70,7 +70,65 @@ const Signal& Monitor::step(double begin, double end, const uint8_t* atoms) {
   return signal_[n - 1];
 }
 
+bool Monitor::at(double now, const uint8_t* atoms) {
+  const size_t n = code_.size();
+  at_.resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    const Instr& in = code_[i];
+    const bool a = in.a >= 0 && at_[static_cast<size_t>(in.a)];
+    const bool b = in.b >= 0 && at_[static_cast<size_t>(in.b)];
+    bool v = false;
+    switch (in.code) {
+      case Code::True: v = true; break;
+      case Code::Atom: v = atoms[in.atom] != 0; break;
+      case Code::Not: v = !a; break;
+      case Code::And: v = a && b; break;
+      case Code::Or: v = a || b; break;
+      case Code::Implies: v = !a || b; break;
+      case Code::Once: v = once_[state_[i]].at(a, now); break;
+      case Code::Historically: v = historically_[state_[i]].at(a, now); break;
+      case Code::Since: v = since_[state_[i]].at(a, b, now); break;
+      default: break;  // False, Pre, Bind, Exists, Forall: false, as step() has them
+    }
+    at_[i] = v;
+  }
+  return at_[n - 1] != 0;
+}
+
+double Monitor::next_change(double now) const {
+  double next = kNever;
+  for (size_t i = 0; i < code_.size(); ++i) {
+    const Instr& in = code_[i];
+    const bool a = in.a >= 0 && at_[static_cast<size_t>(in.a)];
+    const bool b = in.b >= 0 && at_[static_cast<size_t>(in.b)];
+    double t = kNever;
+    switch (in.code) {
+      case Code::Once: t = once_[state_[i]].next_change(a, now); break;
+      case Code::Historically: t = historically_[state_[i]].next_change(a, now); break;
+      case Code::Since: t = since_[state_[i]].next_change(a, b, now); break;
+      default: break;  // the others change only when their operands do
+    }
+    if (t < next) next = t;
+  }
+  return next;
+}
+
 namespace {
+
+// Each sub-formula's value at the clock (Monitor::at), the atoms held.
+class ClockWalker : public explain::Walker {
+ public:
+  ClockWalker(const Program& program, const std::vector<uint8_t>& at, double now)
+      : Walker(program, true, now), at_(at), now_(now) {}
+
+ protected:
+  bool value(size_t i) const override { return at_[i] != 0; }
+  std::string held(size_t) const override { return "at time " + explain::seconds(now_) + " (held since the last message)"; }
+
+ private:
+  const std::vector<uint8_t>& at_;
+  double now_;
+};
 
 // Each sub-formula's value at time t: read from its signal over the segment.
 class DenseWalker : public explain::Walker {
@@ -92,5 +150,7 @@ class DenseWalker : public explain::Walker {
 }  // namespace
 
 std::vector<std::string> Monitor::explain(double t) const { return DenseWalker(program_, signal_, t, begin_, end_).run(); }
+
+std::vector<std::string> Monitor::explain_at(double now) const { return ClockWalker(program_, at_, now).run(); }
 
 }  // namespace rvc::engine::dense

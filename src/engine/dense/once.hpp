@@ -6,6 +6,7 @@
 // O(1) amortized plus the changes it outputs, whatever a and b are.
 #pragma once
 
+#include "engine/dense/lookahead.hpp"
 #include "engine/dense/signal.hpp"
 #include "engine/interval_queue.hpp"
 #include "spec/ast.hpp"
@@ -24,6 +25,12 @@ struct Once {
     }
     emit(p[0].t, end, out);
   }
+
+  // Clock-driven monitoring (lookahead.hpp), after a step that ended at
+  // `now`, the operand holding `input` from there on: the value at `now`,
+  // and the first time after it when the value can change.
+  bool at(bool input, double now) const { return window_at(window, input, lo, now); }
+  double next_change(bool input, double now) const { return window_next_change(window, input, lo, now); }
 
   // Writes the union of the queued intervals restricted to [begin, end).
   void emit(double begin, double end, Signal& out) {

@@ -16,6 +16,7 @@
 // monitors read `since` written without bounds so; its plain ones do not.
 #pragma once
 
+#include "engine/dense/lookahead.hpp"
 #include "engine/dense/signal.hpp"
 #include "engine/interval_queue.hpp"
 #include "spec/ast.hpp"
@@ -26,6 +27,19 @@ struct Since {
   double lo = 0, hi = spec::kInfinity;
   bool right_suffices = false;
   IntervalQueue<double> candidates;
+
+  // Clock-driven monitoring (lookahead.hpp), after a step that ended at
+  // `now`, the operands holding `left` and `right` from there on. While the
+  // left side fails the output is constant (candidates are dropped at every
+  // cut); while it holds, since is once over the candidates.
+  bool at(bool left, bool right, double now) const {
+    if (!left) return right_suffices && right;
+    return window_at(candidates, right, lo, now);
+  }
+  double next_change(bool left, bool right, double now) const {
+    if (!left) return kNever;
+    return window_next_change(candidates, right, lo, now);
+  }
 
   void update(const Signal& left, const Signal& right, double end, Signal& out) {
     out.clear();

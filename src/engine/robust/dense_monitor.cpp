@@ -76,4 +76,63 @@ const RealSignal& DenseMonitor::step(double begin, double end, const double* mar
   return signal_.back();
 }
 
+double DenseMonitor::since_at(const Instr& in, const Since& s) const {
+  // Repeating max(ψ, min(φ, value before)) over a constant stretch changes nothing, so it
+  // keeps this value for as long as the operands hold.
+  return std::max(at_[static_cast<size_t>(in.b)], std::min(at_[static_cast<size_t>(in.a)], s.held));
+}
+
+double DenseMonitor::at(double now, const double* margins) {
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  at_.resize(code_.size());
+  for (size_t i = 0; i < code_.size(); ++i) {
+    const Instr& in = code_[i];
+    const double a = in.a >= 0 ? at_[static_cast<size_t>(in.a)] : 0;
+    const double b = in.b >= 0 ? at_[static_cast<size_t>(in.b)] : 0;
+    double v = -kInf;  // False, Pre, Bind, Exists, Forall: as step() has them
+    switch (in.code) {
+      case Code::True: v = kInf; break;
+      case Code::Atom: v = margins[in.atom]; break;
+      case Code::Not: v = -a; break;
+      case Code::And: v = std::min(a, b); break;
+      case Code::Or: v = std::max(a, b); break;
+      case Code::Implies: v = std::max(-a, b); break;
+      case Code::Once:
+      case Code::Historically: v = window_[static_cast<size_t>(state_[i])].at(a, now); break;
+      case Code::Since: {
+        const Since& s = since_[static_cast<size_t>(state_[i])];
+        v = since_at(in, s);
+        if (s.bounded >= 0) {
+          const BoundedSince& bs = bounded_[static_cast<size_t>(s.bounded)];
+          v = std::min(bs.hold.at(v, now), bs.window.at(b, now));
+        }
+        break;
+      }
+      default: break;
+    }
+    at_[i] = v;
+  }
+  return at_.back();
+}
+
+double DenseMonitor::next_change(double now) const {
+  double next = std::numeric_limits<double>::infinity();
+  for (size_t i = 0; i < code_.size(); ++i) {
+    const Instr& in = code_[i];
+    double t = next;
+    if (in.code == Code::Once || in.code == Code::Historically) {
+      t = window_[static_cast<size_t>(state_[i])].next_change(at_[static_cast<size_t>(in.a)], now);
+    } else if (in.code == Code::Since) {  // unbounded: constant while its operands are
+      const Since& s = since_[static_cast<size_t>(state_[i])];
+      if (s.bounded >= 0) {
+        const BoundedSince& bs = bounded_[static_cast<size_t>(s.bounded)];
+        t = std::min(bs.hold.next_change(since_at(in, s), now),
+                     bs.window.next_change(at_[static_cast<size_t>(in.b)], now));
+      }
+    }
+    next = std::min(next, t);
+  }
+  return next;
+}
+
 }  // namespace rvc::engine::robust

@@ -27,6 +27,12 @@ class DenseMonitor {
   // The atoms' margins held over [begin, end): the property's robustness over it.
   const RealSignal& step(double begin, double end, const double* margins);
 
+  // Clock-driven monitoring (dense::Monitor::at and next_change): after a
+  // step that ended at `now`, the margins held from there on, the
+  // robustness at `now`; then the first time after it at which it can change.
+  double at(double now, const double* margins);
+  double next_change(double now) const;
+
  private:
   struct Since {
     double held;  // the unbounded value at the end of the last piece
@@ -38,9 +44,12 @@ class DenseMonitor {
     RealSignal unbounded, held, windowed;  // scratch, reused every segment
   };
   void since(const Instr& in, Since& s, double end, RealSignal& out);
+  // The unbounded since's value at the clock, its operands held (at_ filled).
+  double since_at(const Instr& in, const Since& s) const;
 
   std::vector<Instr> code_;
   std::vector<RealSignal> signal_;
+  std::vector<double> at_;  // at(): each sub-formula's robustness at the clock
   std::vector<int32_t> state_;
   std::vector<DenseWindow> window_;
   std::vector<Since> since_;
