@@ -115,10 +115,14 @@ void append_float(std::string& json, double v) {
   if (std::isinf(v)) return void(json += v < 0 ? "-Infinity" : "Infinity");
   if (v == 0) return void(json += std::signbit(v) ? "-0.0" : "0.0");
   char buf[64];
-  // Integral values with an exponent: 21 plain digits would be an integer too big for a JSON reader.
-  const auto format = v == std::floor(v) ? std::chars_format::scientific : std::chars_format::general;
+  // Shortest form, a float as a float ("5.0"); large integral values with an
+  // exponent: 21 plain digits would be an integer too big for a JSON reader.
+  const bool integral = v == std::floor(v);
+  const auto format = integral && std::fabs(v) >= 1e15 ? std::chars_format::scientific : std::chars_format::general;
   auto [p, ec] = std::to_chars(buf, buf + sizeof buf, v, format);
   json.append(buf, p);
+  if (integral && format == std::chars_format::general && json.find_first_of(".e", json.size() - (p - buf)) == std::string::npos)
+    json += ".0";
 }
 
 void append_string(std::string& json, std::string_view s) {
