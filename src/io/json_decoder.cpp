@@ -55,7 +55,7 @@ inline bool key_is(simdjson::ondemand::raw_json_string raw, const std::string& n
 // NaN, Infinity, -Infinity: the words `rvc echo` and `rvc msg decode` write
 // for a non-finite float (as Python's json module does), which simdjson does
 // not read as numbers. The value is such a word: its number, else false.
-bool non_finite(simdjson::ondemand::value& value, double& d) {
+[[gnu::cold, gnu::noinline]] bool non_finite(simdjson::ondemand::value value, double& d) {
   std::string_view token = value.raw_json_token();
   while (!token.empty() && json_space(token.back())) token.remove_suffix(1);
   if (token == "NaN") return d = std::numeric_limits<double>::quiet_NaN(), true;
@@ -228,13 +228,21 @@ __attribute__((always_inline)) inline bool JsonDecoder::fast_path(KeyNode& node,
   double d;
   if (value.get_double().get(d)) return false;
   if (std::fabs(d) >= spec::kTwo53) [[unlikely]] {  // maybe an integer a double cannot hold: its text decides
-    FieldValue v;
-    set_json_number(v, value.raw_json_token(), d);
-    number_tests_exact(node, v);
+    number_tests_from_text(node, value.raw_json_token(), d);
     return true;
   }
   number_tests(node, d);
   return true;
+}
+
+void JsonDecoder::number_tests_exact(const KeyNode& node, const FieldValue& v) {
+  for (int id : node.tests) next_[id] = static_cast<uint8_t>(compare_test(atoms_.tests()[id].op, v, atoms_.tests()[id].value));
+}
+
+void JsonDecoder::number_tests_from_text(const KeyNode& node, std::string_view token, double d) {
+  FieldValue v;
+  set_json_number(v, token, d);
+  number_tests_exact(node, v);
 }
 
 JsonDecoder::KeyNode* JsonDecoder::child(KeyNode& parent, const std::string& name) {

@@ -131,7 +131,9 @@ class JsonDecoder {
   void begin_message();
   void bool_tests(const KeyNode& node, bool b);
   void number_tests(const KeyNode& node, double d);
-  void number_tests_exact(const KeyNode& node, const FieldValue& v);
+  [[gnu::noinline]] void number_tests_exact(const KeyNode& node, const FieldValue& v);
+  // From 2^53 up (rare: out of the hot path): the exact value read from the number's text.
+  [[gnu::cold, gnu::noinline]] void number_tests_from_text(const KeyNode& node, std::string_view token, double d);
   bool apply_value(KeyNode& node, const FieldValue& value, std::string& error, std::vector<std::string>* warnings);
   void prepare(KeyNode& node);
   static void remember(KeyNode& node, size_t position, simdjson::ondemand::raw_json_string raw, KeyNode* target);
@@ -207,10 +209,6 @@ inline void JsonDecoder::number_tests(const KeyNode& node, double d) {
     }
     next_[id] = r;
   }
-}
-
-inline void JsonDecoder::number_tests_exact(const KeyNode& node, const FieldValue& v) {
-  for (int id : node.tests) next_[id] = static_cast<uint8_t>(compare_test(atoms_.tests()[id].op, v, atoms_.tests()[id].value));
 }
 
 }  // namespace rvc::io

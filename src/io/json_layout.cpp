@@ -142,7 +142,7 @@ inline const char* scan_scalar(const char* p, const char* end, bool convert, Fie
     }
     default:
       v.kind = ValueKind::Number;
-      v.exact = {};
+      v.exact.kind = spec::ExactInt::None;  // (its bits mean nothing then)
       return scan_number(p, end, convert, v.d, v.exact);
   }
 }
