@@ -55,14 +55,15 @@ inline bool key_is(simdjson::ondemand::raw_json_string raw, const std::string& n
 // NaN, Infinity, -Infinity: the words `rvc echo` and `rvc msg decode` write
 // for a non-finite float (as Python's json module does), which simdjson does
 // not read as numbers. The value is such a word: its number, else false.
-[[gnu::cold, gnu::noinline]] bool non_finite(simdjson::ondemand::value value, double& d) {
-  std::string_view token = value.raw_json_token();
+[[gnu::cold, gnu::noinline]] bool non_finite_text(std::string_view token, double& d) {
   while (!token.empty() && json_space(token.back())) token.remove_suffix(1);
   if (token == "NaN") return d = std::numeric_limits<double>::quiet_NaN(), true;
   if (token == "Infinity") return d = std::numeric_limits<double>::infinity(), true;
   if (token == "-Infinity") return d = -std::numeric_limits<double>::infinity(), true;
   return false;
 }
+
+inline bool non_finite(simdjson::ondemand::value& value, double& d) { return non_finite_text(value.raw_json_token(), d); }
 
 // Reads a value no property tests, only to check that it is well-formed:
 // simdjson's on-demand API skips unread values without validating them, and
