@@ -158,6 +158,35 @@ bool integer_range(Prim prim, bool negative, uint64_t magnitude) {
   return negative ? magnitude <= min_magnitude : magnitude <= max;
 }
 
+// Well-formed UTF-8 (rosidl reads definitions as UTF-8; CDR strings must be).
+bool utf8(std::string_view s) {
+  for (size_t i = 0; i < s.size();) {
+    const auto c = static_cast<unsigned char>(s[i]);
+    if (c < 0x80) {
+      ++i;
+      continue;
+    }
+    size_t n = 0;  // continuation bytes
+    uint32_t cp = 0;
+    if ((c >> 5) == 6) n = 1, cp = c & 0x1f;
+    else if ((c >> 4) == 14) n = 2, cp = c & 0x0f;
+    else if ((c >> 3) == 30) n = 3, cp = c & 0x07;
+    else return false;
+    if (i + n >= s.size()) return false;
+    for (size_t k = 1; k <= n; ++k) {
+      const auto d = static_cast<unsigned char>(s[i + k]);
+      if ((d >> 6) != 2) return false;
+      cp = cp << 6 | (d & 0x3f);
+    }
+    // Overlong forms, surrogates and code points past U+10FFFF are not UTF-8.
+    if ((n == 1 && cp < 0x80) || (n == 2 && (cp < 0x800 || (cp >= 0xd800 && cp <= 0xdfff))) ||
+        (n == 3 && (cp < 0x10000 || cp > 0x10ffff)))
+      return false;
+    i += n + 1;
+  }
+  return true;
+}
+
 // One primitive value (rosidl's parse_primitive_value_string).
 bool scalar(Prim prim, uint32_t string_bound, std::string_view text, std::string& json, std::string& error) {
   const std::string shown(text);
@@ -208,6 +237,10 @@ bool scalar(Prim prim, uint32_t string_bound, std::string_view text, std::string
         value += inner[i];
       }
       break;
+    }
+    if (!utf8(value) || value.find('\0') != std::string::npos) {
+      error = "a string value must be UTF-8 text without NUL bytes";
+      return false;
     }
     if (string_bound && value.size() > string_bound) {
       error = "a string of " + std::to_string(value.size()) + " bytes over its bound " + std::to_string(string_bound);

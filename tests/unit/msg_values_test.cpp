@@ -89,6 +89,9 @@ TEST(MsgValues, WhatRosidlRefusesIsRefusedAtItsColumn) {
   EXPECT_EQ(refusal("int32[] a 1\n"), "T.msg:1:11: an array value is written [a, b, ...], not '1'");
   EXPECT_EQ(refusal("string<=3 s \"abcd\"\n"), "T.msg:1:13: a string of 4 bytes over its bound 3");
   EXPECT_EQ(refusal("uint8 K=0x100\n"), "T.msg:1:9: 0x100 does not fit in uint8");
+  // Found by fuzz_msg: a string default that is not UTF-8 was accepted, and then no encoder could write it.
+  EXPECT_EQ(refusal("string s \"a\xff\"\n"), "T.msg:1:10: a string value must be UTF-8 text without NUL bytes");
+  EXPECT_EQ(refusal("string[] s ['\xc3']\n"), "T.msg:1:12: element 0: a string value must be UTF-8 text without NUL bytes");
 }
 
 TEST(MsgValues, SizesAreBoundedWhereTheyAreWritten) {
