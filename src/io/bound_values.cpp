@@ -1,6 +1,7 @@
 #include "io/bound_values.hpp"
 
 #include <charconv>
+#include <cmath>
 
 #include "io/json_writer.hpp"
 
@@ -14,6 +15,11 @@ uint32_t BoundValues::id(const FieldValue& v) {
       key_.append(v.s);
       break;
     case ValueKind::Number: {
+      if (v.exact.kind != spec::ExactInt::None && spec::order_int_double(v.exact, v.d) != spec::Equal) {
+        key_.push_back('i');  // an integer no double equals: its digits ('n' keys are doubles)
+        spec::append_exact(key_, v.exact);
+        break;
+      }
       char buf[32];
       const double d = v.d == 0 ? 0.0 : v.d;  // -0 is 0
       const auto written = std::to_chars(buf, buf + sizeof buf, d);  // shortest exact text: one key per double
@@ -35,7 +41,11 @@ std::string BoundValues::json(uint32_t id) const {
   std::string out;
   switch (key[0]) {
     case 's': append_json_string(out, std::string_view(key).substr(1)); break;
-    case 'n': out = key.substr(1); break;
+    case 'n':
+    case 'i':
+      out = key.substr(1);
+      if (out == "nan" || out == "inf" || out == "-inf") out = non_finite_word(out == "nan" ? NAN : out[0] == '-' ? -INFINITY : INFINITY);
+      break;
     default: out = key == "b1" ? "true" : "false"; break;
   }
   return out;

@@ -34,11 +34,71 @@ T byteswap(T v) {
 
 constexpr bool kHostLittle = __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__;
 
-// Floats as the JSON writer prints them, but -0.0 keeps its sign: a sample
-// decoded and encoded again must give back the same bytes.
+// Floats as the JSON writer prints them, but -0.0 keeps its sign and NaN and
+// the infinities are the bare words NaN, Infinity and -Infinity (as Python's
+// json module writes and reads them, and rvc's JSON readers accept): a sample
+// decoded and encoded again gives back the same bytes (a NaN's sign and
+// payload aside), and `rvc check` on `rvc echo` output gives the typed verdicts.
 void append_float(std::string& out, double v) {
   if (v == 0 && std::signbit(v)) out += "-0.0";
+  else if (!std::isfinite(v)) out += non_finite_word(v);
   else append_number(out, v);
+}
+
+// simdjson's DOM refuses the words NaN, Infinity and -Infinity: outside
+// strings they become strings no field can hold (a NUL first), which
+// Writer::floating reads back as the numbers. False when there are none.
+constexpr std::string_view kNonFinite[] = {"NaN", "Infinity", "-Infinity"};
+constexpr std::string_view kNonFiniteSentinel[] = {"\"\\u0000NaN\"", "\"\\u0000Infinity\"", "\"\\u0000-Infinity\""};
+
+bool non_finite_as_strings(std::string_view json, std::string& out) {
+  out.clear();
+  bool found = false, in_string = false;
+  for (size_t i = 0; i < json.size(); ++i) {
+    const char c = json[i];
+    if (in_string) {
+      out += c;
+      if (c == '\\' && i + 1 < json.size()) out += json[++i];  // an escape: the next byte cannot end the string
+      else if (c == '"') in_string = false;
+      continue;
+    }
+    bool replaced = false;
+    for (size_t k = 0; k < 3 && !replaced; ++k) {
+      if (json.substr(i, kNonFinite[k].size()) != kNonFinite[k]) continue;
+      out += kNonFiniteSentinel[k];
+      i += kNonFinite[k].size() - 1;
+      replaced = found = true;
+    }
+    if (replaced) continue;
+    out += c;
+    in_string = c == '"';
+  }
+  return found;
+}
+
+// The number a sentinel string stands for, or false.
+bool sentinel_number(simdjson::dom::element v, double& d) {
+  std::string_view s;
+  if (v.get(s) != simdjson::SUCCESS || s.empty() || s[0] != '\0') return false;
+  if (s.substr(1) == "NaN") return d = std::numeric_limits<double>::quiet_NaN(), true;
+  if (s.substr(1) == "Infinity") return d = std::numeric_limits<double>::infinity(), true;
+  if (s.substr(1) == "-Infinity") return d = -std::numeric_limits<double>::infinity(), true;
+  return false;
+}
+
+// A value for an error message: a sentinel as the word it was.
+std::string shown(simdjson::dom::element v) {
+  std::string_view s;
+  if (v.get(s) == simdjson::SUCCESS && !s.empty() && s[0] == '\0') return std::string(s.substr(1));
+  return simdjson::to_string(v);
+}
+
+// Parses JSON text that may hold NaN, Infinity, -Infinity.
+simdjson::error_code parse_json(simdjson::dom::parser& parser, std::string_view json, std::string& scratch,
+                                simdjson::dom::element& doc) {
+  auto e = parser.parse(json.data(), json.size()).get(doc);
+  if (e == simdjson::SUCCESS || !non_finite_as_strings(json, scratch)) return e;
+  return parser.parse(scratch).get(doc);
 }
 
 // ------------------------------------------------------------------ decoding
@@ -191,8 +251,9 @@ class Writer {
       path_ += f.name;
       simdjson::dom::element v;
       bool has = present && obj[f.name].get(v) == simdjson::SUCCESS;
-      if (!has && !f.default_text.empty()) {
-        if (default_doc(f, v)) has = true;
+      if (!has && !f.default_json.empty()) {
+        if (!default_doc(f, v)) return false;
+        has = true;
       }
       if (!field(f.type, v, has)) return false;
       path_.resize(path_size);
@@ -206,16 +267,13 @@ class Writer {
     return false;
   }
 
-  // The .msg default of a field, as a JSON value ("1.5", "true", "\"text\"", "[1, 2]").
+  // The .msg default of a field: its JSON text as the parser read it the rosidl way
+  // (msg/msg_values.hpp: "1.5", "true", "\"text\"", "[16,5]", "NaN").
   bool default_doc(const Field& f, simdjson::dom::element& v) {
-    std::string text = f.default_text;
-    bool is_string = f.type.prim == Prim::String && f.type.array == ArrayKind::None;
-    if (is_string && (text.empty() || (text.front() != '"' && text.front() != '\''))) text = "\"" + text + "\"";
-    if (is_string && text.front() == '\'') text = "\"" + text.substr(1, text.size() - 2) + "\"";
-    if (text == "True") text = "true";
-    if (text == "False") text = "false";
     defaults_.push_back(std::make_unique<simdjson::dom::parser>());
-    return defaults_.back()->parse(text).get(v) == simdjson::SUCCESS;
+    std::string scratch;
+    if (parse_json(*defaults_.back(), f.default_json, scratch, v) == simdjson::SUCCESS) return true;
+    return fail("its default " + f.default_text + " does not read as JSON");  // the parser wrote it: never
   }
 
   void align(size_t n) {
@@ -256,7 +314,7 @@ class Writer {
     }
     if (v.get(d) == simdjson::SUCCESS) return fail("expected an integer, got " + simdjson::to_string(v));
     if (v.is_bool()) return fail("expected an integer, got a bool");
-    return fail("expected an integer, got " + simdjson::to_string(v));
+    return fail("expected an integer, got " + shown(v));
   }
 
   bool range(simdjson::dom::element v) { return fail(simdjson::to_string(v) + " is out of range"); }
@@ -265,8 +323,9 @@ class Writer {
   bool floating(simdjson::dom::element v, bool has) {
     double d = 0;
     if (has) {
-      if (v.is_null()) d = std::numeric_limits<double>::quiet_NaN();  // cdr_to_json writes NaN and infinities as null
-      else if (v.get(d) != simdjson::SUCCESS) return fail("expected a number, got " + simdjson::to_string(v));
+      // NaN, Infinity, -Infinity (as cdr_to_json writes them); null as NaN (as it wrote them before).
+      if (v.is_null()) d = std::numeric_limits<double>::quiet_NaN();
+      else if (!sentinel_number(v, d) && v.get(d) != simdjson::SUCCESS) return fail("expected a number, got " + shown(v));
     }
     put<T>(static_cast<T>(d));
     return true;
@@ -276,7 +335,7 @@ class Writer {
     switch (t.prim) {
       case Prim::Bool: {
         bool b = false;
-        if (has && v.get(b) != simdjson::SUCCESS) return fail("expected true or false, got " + simdjson::to_string(v));
+        if (has && v.get(b) != simdjson::SUCCESS) return fail("expected true or false, got " + shown(v));
         put<uint8_t>(b ? 1 : 0);
         return true;
       }
@@ -293,6 +352,7 @@ class Writer {
       case Prim::String: {
         std::string_view s;
         if (has && v.get(s) != simdjson::SUCCESS) return fail("expected a string, got " + simdjson::to_string(v));
+        if (double ignored; has && sentinel_number(v, ignored)) return fail("expected a string, got " + shown(v));
         if (s.find('\0') != std::string_view::npos) return fail("a string cannot hold a NUL");
         if (t.string_bound && s.size() > t.string_bound)
           return fail("string of " + std::to_string(s.size()) + " bytes over its bound " + std::to_string(t.string_bound));
@@ -383,7 +443,8 @@ bool json_to_cdr(const MessageType& type, std::string_view json, std::string& sa
                  const CdrWriteOptions& options) {
   simdjson::dom::parser parser;
   simdjson::dom::element doc;
-  if (auto e = parser.parse(json.data(), json.size()).get(doc); e != simdjson::SUCCESS) {
+  std::string scratch;
+  if (auto e = parse_json(parser, json, scratch, doc); e != simdjson::SUCCESS) {
     error = std::string("not JSON: ") + simdjson::error_message(e);
     // simdjson's DOM refuses integer literals of 20 digits or more.
     if (e == simdjson::NUMBER_ERROR) error += " (write integers beyond 2^64 in exponent form, e.g. 5.9e+20)";

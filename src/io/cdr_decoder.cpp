@@ -55,6 +55,16 @@ bool number(CdrCursor& in, double& d) {
   return true;
 }
 
+// A 64-bit integer: its double and, beyond 2^53, its exact value (compared exactly).
+template <typename T>
+bool number(CdrCursor& in, FieldValue& out) {
+  T v{};
+  if (!in.read(v)) return false;
+  out.d = static_cast<double>(v);
+  out.exact = spec::exact_of(v);
+  return true;
+}
+
 }  // namespace
 
 CdrDecoder::CdrDecoder(const engine::AtomTable& atoms, const MessageType& type, const DecoderOptions& options)
@@ -262,8 +272,8 @@ bool CdrDecoder::tested_field(CdrCursor& in, const FieldPlan& f) {
     case Prim::UInt16: ok = number<uint16_t>(in, v.d); break;
     case Prim::Int32: ok = number<int32_t>(in, v.d); break;
     case Prim::UInt32: ok = number<uint32_t>(in, v.d); break;
-    case Prim::Int64: ok = number<int64_t>(in, v.d); break;
-    case Prim::UInt64: ok = number<uint64_t>(in, v.d); break;
+    case Prim::Int64: ok = number<int64_t>(in, v); break;
+    case Prim::UInt64: ok = number<uint64_t>(in, v); break;
     case Prim::Float32: ok = number<float>(in, v.d); break;
     case Prim::Float64: ok = number<double>(in, v.d); break;
     case Prim::String:

@@ -55,15 +55,15 @@ int evaluate_test(const spec::FieldTest& t, const FieldValue& v) {
     case FOp::Ne: {
       int eq = -1;
       if (lit == spec::Literal::Kind::Bool && v.kind == ValueKind::Bool) eq = v.b == t.value.b;
-      else if (lit == spec::Literal::Kind::Number && number) eq = v.d == t.value.number;
+      else if (lit == spec::Literal::Kind::Number && number) eq = compare_test(FOp::Eq, v, t.value);
       else if (lit == spec::Literal::Kind::String && v.kind == ValueKind::String) eq = v.s == t.value.text;
       if (eq < 0) return -1;
       return t.op == FOp::Eq ? eq : !eq;
     }
-    case FOp::Lt: return number ? v.d < t.value.number : -1;
-    case FOp::Le: return number ? v.d <= t.value.number : -1;
-    case FOp::Gt: return number ? v.d > t.value.number : -1;
-    case FOp::Ge: return number ? v.d >= t.value.number : -1;
+    case FOp::Lt:
+    case FOp::Le:
+    case FOp::Gt:
+    case FOp::Ge: return number ? compare_test(t.op, v, t.value) : -1;
   }
   return -1;
 }

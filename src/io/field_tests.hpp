@@ -4,6 +4,7 @@
 // a message sent as JSON or as a typed sample.
 #pragma once
 
+#include <cmath>
 #include <string>
 #include <string_view>
 
@@ -16,9 +17,40 @@ enum class ValueKind : unsigned char { Null, Bool, Number, String, Array, Object
 struct FieldValue {
   ValueKind kind = ValueKind::Null;
   bool b = false;
-  double d = 0;
+  double d = 0;          // a number's value (rounded, for an integer beyond 2^53)
   std::string_view s;
+  spec::ExactInt exact;  // such an integer exactly: comparisons use it (spec/exact_number.hpp)
 };
+
+// A number's test against the test's literal, exactly: 1 or 0 (NaN: every
+// comparison false but !=, as IEEE 754 has it).
+inline int compare_test(spec::FieldTest::Op op, const FieldValue& v, const spec::Literal& lit) {
+  const spec::Order o = spec::order_numbers(v.d, v.exact, lit.number, lit.exact);
+  using Op = spec::FieldTest::Op;
+  switch (op) {
+    case Op::Eq: return o == spec::Equal;
+    case Op::Ne: return o != spec::Equal;
+    case Op::Lt: return o == spec::Less;
+    case Op::Le: return o == spec::Less || o == spec::Equal;
+    case Op::Gt: return o == spec::Greater;
+    case Op::Ge: return o == spec::Greater || o == spec::Equal;
+    default: return 1;  // Present
+  }
+}
+
+// A JSON number token already read as the double d (simdjson validated it):
+// an integer literal beyond 2^53 keeps its exact value, as Python's json
+// reads integers. (Beyond the 64-bit range it stays the double.)
+inline void set_json_number(FieldValue& v, std::string_view token, double d) {
+  v.kind = ValueKind::Number;
+  v.d = d;
+  v.exact = {};
+  while (!token.empty() && (token.back() == ' ' || token.back() == '\t' || token.back() == '\r' || token.back() == '\n'))
+    token.remove_suffix(1);
+  double exact_d;
+  spec::ExactInt exact;
+  if (std::fabs(d) >= spec::kTwo53 && spec::integer_literal(token, exact_d, exact)) v.d = exact_d, v.exact = exact;
+}
 
 // 1 or 0: the test's value; -1: the value has a type the test cannot use
 // (the test then keeps its previous value, or the message is refused in

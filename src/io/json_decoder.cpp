@@ -1,6 +1,7 @@
 #include "io/json_decoder.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 #include <cstring>
@@ -51,6 +52,19 @@ inline bool key_is(simdjson::ondemand::raw_json_string raw, const std::string& n
   return k[n] == '"';
 }
 
+// NaN, Infinity, -Infinity: the words `rvc echo` and `rvc msg decode` write
+// for a non-finite float (as Python's json module does), which simdjson does
+// not read as numbers. The value is such a word: its number, else false.
+[[gnu::cold, gnu::noinline]] bool non_finite_text(std::string_view token, double& d) {
+  while (!token.empty() && json_space(token.back())) token.remove_suffix(1);
+  if (token == "NaN") return d = std::numeric_limits<double>::quiet_NaN(), true;
+  if (token == "Infinity") return d = std::numeric_limits<double>::infinity(), true;
+  if (token == "-Infinity") return d = -std::numeric_limits<double>::infinity(), true;
+  return false;
+}
+
+inline bool non_finite(simdjson::ondemand::value& value, double& d) { return non_finite_text(value.raw_json_token(), d); }
+
 // Reads a value no property tests, only to check that it is well-formed:
 // simdjson's on-demand API skips unread values without validating them, and
 // a message must be rejected for malformed JSON whatever the properties read
@@ -60,11 +74,12 @@ inline bool key_is(simdjson::ondemand::raw_json_string raw, const std::string& n
 simdjson::error_code validate(simdjson::ondemand::value value, int depth = 0) {
   if (depth > 1024) return simdjson::DEPTH_ERROR;  // simdjson's own default limit
   json_type type;
-  if (auto err = value.type().get(type)) return err;
+  double d;
+  if (auto err = value.type().get(type)) return non_finite(value, d) ? simdjson::SUCCESS : err;
   switch (type) {
     case json_type::number: {
-      double d;
-      return value.get_double().get(d);
+      auto err = value.get_double().get(d);
+      return err && non_finite(value, d) ? simdjson::SUCCESS : err;
     }
     case json_type::string: {
       std::string_view s;
@@ -213,8 +228,22 @@ __attribute__((always_inline)) inline bool JsonDecoder::fast_path(KeyNode& node,
   }
   double d;
   if (value.get_double().get(d)) return false;
+  if (std::fabs(d) >= spec::kTwo53) [[unlikely]] {  // maybe an integer a double cannot hold: its text decides
+    number_tests_from_text(node, value.raw_json_token(), d);
+    return true;
+  }
   number_tests(node, d);
   return true;
+}
+
+void JsonDecoder::number_tests_exact(const KeyNode& node, const FieldValue& v) {
+  for (int id : node.tests) next_[id] = static_cast<uint8_t>(compare_test(atoms_.tests()[id].op, v, atoms_.tests()[id].value));
+}
+
+void JsonDecoder::number_tests_from_text(const KeyNode& node, std::string_view token, double d) {
+  FieldValue v;
+  set_json_number(v, token, d);
+  number_tests_exact(node, v);
 }
 
 JsonDecoder::KeyNode* JsonDecoder::child(KeyNode& parent, const std::string& name) {
@@ -324,7 +353,16 @@ bool JsonDecoder::decode_value(KeyNode& target, simdjson::ondemand::value value,
   if (target.kind != Kind::General && !options_.robustness && fast_path(target, value)) return true;
   json_type type;
   if (auto err = value.type().get(type)) {
-    return invalid(error, err);
+    double d;
+    if (!non_finite(value, d)) return invalid(error, err);
+    if (target.time_part) {
+      error = "time field \"" + options_.time_field + "\" is not a finite number";
+      return false;
+    }
+    // A non-finite float: a number to the tests (IEEE 754: NaN compares false but for !=).
+    if (!target.tests.empty() && !apply_value(target, FieldValue{ValueKind::Number, false, d, {}, {}}, error, warnings))
+      return false;
+    return true;
   }
   if (target.time_part == 1) {
     double t;
@@ -426,14 +464,16 @@ bool JsonDecoder::apply_tests(KeyNode& node, simdjson::ondemand::value value, js
   std::string_view s;
   simdjson::error_code err = simdjson::SUCCESS;
   if (type == json_type::boolean) err = value.get_bool().get(b);
-  else if (type == json_type::number) err = value.get_double().get(d);
+  else if (type == json_type::number && (err = value.get_double().get(d)) && non_finite(value, d)) err = simdjson::SUCCESS;
   else if (type == json_type::string) err = value.get_string().get(s);
   if (err) {
     error = std::string("invalid JSON value for field \"") + node.name + "\": " + simdjson::error_message(err);
     malformed_ = true;
     return false;
   }
-  return apply_value(node, FieldValue{kind_of(type), b, d, s}, error, warnings);
+  FieldValue v{kind_of(type), b, d, s, {}};
+  if (type == json_type::number) set_json_number(v, value.raw_json_token(), d);
+  return apply_value(node, v, error, warnings);
 }
 
 // A scalar's tests, whatever its type (a type a test cannot use leaves that

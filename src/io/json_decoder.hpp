@@ -131,6 +131,9 @@ class JsonDecoder {
   void begin_message();
   void bool_tests(const KeyNode& node, bool b);
   void number_tests(const KeyNode& node, double d);
+  [[gnu::noinline]] void number_tests_exact(const KeyNode& node, const FieldValue& v);
+  // From 2^53 up (rare: out of the hot path): the exact value read from the number's text.
+  [[gnu::cold, gnu::noinline]] void number_tests_from_text(const KeyNode& node, std::string_view token, double d);
   bool apply_value(KeyNode& node, const FieldValue& value, std::string& error, std::vector<std::string>* warnings);
   void prepare(KeyNode& node);
   static void remember(KeyNode& node, size_t position, simdjson::ondemand::raw_json_string raw, KeyNode* target);
@@ -185,7 +188,10 @@ inline void JsonDecoder::bool_tests(const KeyNode& node, bool b) {
     out[t->id] = b ? t->if_true : t->if_false;
 }
 
-// A number-only field's tests, given its value.
+// A number-only field's tests, given its value. Below 2^53 the double
+// comparisons are exact, whatever the literal (an integer literal beyond 2^53
+// is on the same side of d as its rounded double); from 2^53 up (nanosecond
+// stamps, 64-bit ids) number_tests_exact compares the exact value.
 inline void JsonDecoder::number_tests(const KeyNode& node, double d) {
   for (int id : node.tests) {
     const spec::FieldTest& t = atoms_.tests()[id];

@@ -2,6 +2,7 @@
 // line's layout with simdjson, matching later lines against it, and decoding
 // a matched line's values with the same rules as JsonDecoder::decode().
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 
 #include "io/json_decoder.hpp"
@@ -199,7 +200,8 @@ bool JsonDecoder::decode_matched(std::string& error, std::vector<std::string>* w
         continue;
       case SlotUse::Number:
         if (v.kind != ValueKind::Number) break;
-        number_tests(target, v.d);
+        if (std::fabs(v.d) >= spec::kTwo53) number_tests_exact(target, v);  // (as fast_path)
+        else number_tests(target, v.d);
         continue;
       case SlotUse::Time:  // a number (match() made sure)
         saw_time_ = true;

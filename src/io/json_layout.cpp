@@ -47,7 +47,7 @@ constexpr double kExact10[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,  1
 // its end, or nullptr if it is malformed or one whose reading could differ
 // from simdjson's (out of a double's range, an exponent of 4+ digits): those
 // lines go to simdjson, which decides and words the error.
-const char* scan_number(const char* p, const char* end, bool convert, double& out) {
+const char* scan_number(const char* p, const char* end, bool convert, double& out, spec::ExactInt& exact) {
   const char* q = p;
   const bool negative = *q == '-';
   if (negative && ++q == end) return nullptr;
@@ -97,6 +97,9 @@ const char* scan_number(const char* p, const char* end, bool convert, double& ou
     return q;
   }
   if (!convert && !exponent && digits - fraction <= 300) return q;  // well inside a double's range
+  // An integer of 16 digits or more: exactly, as set_json_number reads it on simdjson's path.
+  if (!exponent && fraction == 0 && spec::integer_literal(std::string_view(p, static_cast<size_t>(q - p)), out, exact))
+    return q;
   // Otherwise the standard library's correctly rounded conversion; a value
   // out of range (or rounding to zero) is left to simdjson.
   double d = 0;
@@ -139,7 +142,8 @@ inline const char* scan_scalar(const char* p, const char* end, bool convert, Fie
     }
     default:
       v.kind = ValueKind::Number;
-      return scan_number(p, end, convert, v.d);
+      v.exact.kind = spec::ExactInt::None;  // (its bits mean nothing then)
+      return scan_number(p, end, convert, v.d, v.exact);
   }
 }
 

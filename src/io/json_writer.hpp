@@ -16,6 +16,9 @@ namespace rvc::io {
 void append_json_string(std::string& out, std::string_view s);
 // Appends a number in the shortest round-trip form; NaN and infinities as null.
 void append_number(std::string& out, double v);
+// NaN, Infinity, -Infinity: how a message's non-finite float is written (as
+// Python's json module writes them; rvc's JSON readers accept them back).
+inline const char* non_finite_word(double v) { return v != v ? "NaN" : v < 0 ? "-Infinity" : "Infinity"; }
 // Appends a number with a fixed count of decimals (wall-clock seconds, rates).
 void append_fixed(std::string& out, double v, int decimals);
 

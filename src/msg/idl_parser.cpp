@@ -1,5 +1,7 @@
 #include "msg/idl_parser.hpp"
 
+#include "msg/msg_values.hpp"
+
 #include <cctype>
 #include <charconv>
 #include <map>
@@ -341,6 +343,8 @@ class Parser {
         if (a.name != "default") continue;
         auto v = a.params.count("value") ? a.params.at("value") : a.params.count("") ? a.params.at("") : "";
         if (f.type.prim == Prim::Message) fail(type_at, "'" + f.name + "': a member of a struct type has no @default");
+        std::string error;
+        if (!rosidl_value(f.type, v, f.default_json, error)) fail(name_at, "'" + f.name + "': @default: " + error);
         f.default_text = v;
       }
       m.fields.push_back(std::move(f));
@@ -355,8 +359,15 @@ class Parser {
     const Token& at = cur();
     double v = const_number(Prim::UInt32);
     if (v < 1) fail(at, "an array size is positive");
+    limit(at, v, "array size");
     expect("]");
     return static_cast<uint32_t>(v);
+  }
+
+  void limit(const Token& at, double size, const char* what) {
+    if (size > kMaxArraySize)
+      fail(at, std::string("the ") + what + " " + std::to_string(static_cast<uint64_t>(size)) + " is over rvc's limit of " +
+                   std::to_string(kMaxArraySize) + " (docs/ros2-types.md)");
   }
 
   // A type specifier: primitive, string<N>, sequence<T, N>, or a scoped name.
@@ -374,8 +385,10 @@ class Parser {
       inner.array = ArrayKind::Unbounded;
       if (accept(",")) {
         inner.array = ArrayKind::Bounded;
+        const Token& bound_at = cur();
         inner.array_size = static_cast<uint32_t>(const_number(Prim::UInt32));
         if (inner.array_size == 0) fail(at, "a sequence bound is positive");
+        limit(bound_at, inner.array_size, "sequence bound");
       }
       expect(">");
       return inner;
@@ -384,8 +397,10 @@ class Parser {
       t.prim = cur().text == "string" ? Prim::String : Prim::WString;
       ++p_;
       if (accept("<")) {
+        const Token& bound_at = cur();
         t.string_bound = static_cast<uint32_t>(const_number(Prim::UInt32));
         if (t.string_bound == 0) fail(at, "a string bound is positive");
+        limit(bound_at, t.string_bound, "string bound");
         expect(">");
       }
       return t;

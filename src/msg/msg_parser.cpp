@@ -1,5 +1,7 @@
 #include "msg/msg_parser.hpp"
 
+#include "msg/msg_values.hpp"
+
 #include <cerrno>
 #include <charconv>
 #include <cmath>
@@ -60,9 +62,12 @@ class LineParser {
   uint32_t parse_count(size_t at, std::string_view digits, const char* what) const {
     uint64_t v = 0;
     auto [p, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), v);
-    if (digits.empty() || ec != std::errc() || p != digits.data() + digits.size() || v == 0 ||
-        v > std::numeric_limits<uint32_t>::max())
+    if (digits.empty() || p != digits.data() + digits.size() || (ec != std::errc() && ec != std::errc::result_out_of_range) ||
+        (ec == std::errc() && v == 0))
       fail(at, std::string("expected a positive ") + what + ", got '" + std::string(digits) + "'");
+    if (ec == std::errc::result_out_of_range || v > kMaxArraySize)
+      fail(at, std::string("the ") + what + " " + std::string(digits) + " is over rvc's limit of " +
+                   std::to_string(kMaxArraySize) + " (docs/ros2-types.md)");
     return static_cast<uint32_t>(v);
   }
 
@@ -138,13 +143,6 @@ class LineParser {
     return std::string(v);
   }
 
-  double parse_number(size_t at, Prim prim, std::string_view text) const {
-    double v = 0;
-    std::string error;
-    if (!prim_value(prim, text, v, error)) fail(at, error);
-    return v;
-  }
-
   // Returns false for a blank or comment-only line.
   bool parse(MessageType& out, std::set<std::string>& names) {
     line_ = strip_comment(line_);
@@ -173,8 +171,11 @@ class LineParser {
       if (type.prim == Prim::String || type.prim == Prim::WString) {
         c.text = unquote(raw);
       } else {
-        c.text = std::string(raw);
-        c.number = parse_number(value_at, type.prim, raw);
+        // As rosidl reads it ("0x10", "+5", "TRUE"); the text kept is the value's JSON
+        // ("16", "5", "true"): exact for 64-bit integers, read again by typed specs.
+        std::string error;
+        if (!rosidl_value(type, raw, c.text, error)) fail(value_at, error);
+        c.number = c.text == "true" ? 1 : c.text == "false" ? 0 : std::strtod(c.text.c_str(), nullptr);
       }
       out.constants.push_back(std::move(c));
       return true;
@@ -187,8 +188,8 @@ class LineParser {
     while (!rest.empty() && is_space(rest.back())) rest.remove_suffix(1);
     if (!rest.empty()) {
       if (f.type.prim == Prim::Message) fail(pos_, "a field of a message type has no default value");
-      if (f.type.array == ArrayKind::None && f.type.prim != Prim::String && f.type.prim != Prim::WString)
-        parse_number(pos_, f.type.prim, rest);  // checks it; the encoder reads default_text again
+      std::string error;
+      if (!rosidl_value(f.type, rest, f.default_json, error)) fail(pos_, error);
       f.default_text = std::string(rest);
     }
     out.fields.push_back(std::move(f));

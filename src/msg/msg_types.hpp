@@ -29,6 +29,17 @@ bool prim_value(Prim prim, std::string_view text, double& value, std::string& er
 
 enum class ArrayKind : uint8_t { None, Fixed, Bounded, Unbounded };
 
+// The largest array size, array or sequence bound and string bound a
+// definition may write (T[N], T[<=N], string<=N; IDL T name[N],
+// sequence<T, N>, string<N>): larger ones are refused where they are
+// written. 16 Mi elements; a sample is at most 4 GiB on the wire anyway.
+inline constexpr uint32_t kMaxArraySize = uint32_t{1} << 24;
+// The largest smallest sample of a type (every fixed array filled, every
+// sequence and string empty): a type over it is refused when it is linked,
+// naming the field, since encoding even its default sample would allocate
+// that much (int32[16777216] of a nested type in a fixed array of 16 Mi...).
+inline constexpr uint64_t kMaxFixedBytes = uint64_t{1} << 26;  // 64 MiB
+
 struct MessageType;
 
 struct FieldType {
@@ -45,6 +56,9 @@ struct Field {
   std::string name;
   FieldType type;
   std::string default_text;  // "float64 x 1.5": "1.5" (as written; empty: none)
+  // The default as JSON text, read as rosidl reads it (msg_values.hpp): "bool b TRUE"
+  // gives "true", "int32[] a [0x10, +5]" gives "[16,5]". Empty: none.
+  std::string default_json;
   int line = 0;
 };
 
@@ -68,6 +82,9 @@ struct MessageType {
   // top-level field names, in the order given.
   std::vector<std::string> keys;
   std::string source;            // where the definition came from (file path, "bundled", "mcap schema")
+  // Bytes of its smallest sample (fixed arrays filled, sequences and strings
+  // empty; alignment not counted), set when linked: at most kMaxFixedBytes.
+  uint64_t fixed_bytes = 0;
 
   std::string full_name() const { return idl_name.empty() ? package + "/msg/" + name : idl_name; }
   const Constant* constant(const std::string& constant_name) const;

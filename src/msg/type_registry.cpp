@@ -231,6 +231,24 @@ const MessageType& TypeRegistry::load(const std::string& key, int depth) {
                      std::to_string(f.line) + ")");
     }
   }
+  // Its smallest sample, bounded (kMaxFixedBytes): a definition must not make
+  // every encoder of a default sample allocate gigabytes.
+  uint64_t bytes = type->fields.empty() ? 1 : 0;
+  for (const auto& f : type->fields) {
+    const uint64_t element = f.type.prim == Prim::Message                                   ? f.type.message->fixed_bytes
+                             : f.type.prim == Prim::String || f.type.prim == Prim::WString ? 4
+                                                                                           : prim_size(f.type.prim);
+    bytes += f.type.array == ArrayKind::None    ? element
+             : f.type.array == ArrayKind::Fixed ? element * f.type.array_size  // <= 2^26 * 2^24: no overflow
+                                                : 4;
+    if (bytes > kMaxFixedBytes) {
+      types_.erase(key);
+      throw MsgError(source + ":" + std::to_string(f.line) + ": field '" + f.name + "' (" + f.type.to_string() +
+                     ") makes the smallest sample of " + key + " over rvc's limit of " +
+                     std::to_string(kMaxFixedBytes >> 20) + " MiB (docs/ros2-types.md)");
+    }
+  }
+  type->fixed_bytes = bytes;
   auto& slot = types_[key];
   slot = std::move(type);
   return *slot;

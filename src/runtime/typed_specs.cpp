@@ -91,6 +91,7 @@ std::optional<spec::Literal> check_test(const spec::FieldTest& test, const Messa
   } else {
     lit.kind = spec::Literal::Kind::Number;
     lit.number = c->number;
+    spec::integer_literal(c->text, lit.number, lit.exact);  // a 64-bit constant, exactly (its text is decimal)
   }
   return lit;
 }

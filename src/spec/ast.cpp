@@ -30,7 +30,12 @@ std::string quote_if_needed(const std::string& key) {
 std::string literal_text(const Literal& l) {
   switch (l.kind) {
     case Literal::Kind::Bool: return l.b ? "true" : "false";
-    case Literal::Kind::Number: return number_text(l.number);
+    case Literal::Kind::Number: {
+      if (l.exact.kind == ExactInt::None) return number_text(l.number);
+      std::string out;  // all its digits: {u == 2^63 - 1} and {u == 2^63} are two tests
+      append_exact(out, l.exact);
+      return out;
+    }
     case Literal::Kind::String: {
       std::string out = "\"";
       for (char c : l.text) {

@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "spec/exact_number.hpp"
+
 namespace rvc::spec {
 
 inline constexpr double kInfinity = std::numeric_limits<double>::infinity();
@@ -26,6 +28,7 @@ struct Literal {
   enum class Kind { Bool, Number, String } kind = Kind::Bool;
   bool b = false;
   double number = 0;
+  ExactInt exact;  // an integer beyond 2^53, exactly (number is its rounded double)
   std::string text;
   bool bare_word = false;  // a String written without quotes ({gear: REVERSE}): may name a message constant
 };

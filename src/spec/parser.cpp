@@ -489,7 +489,12 @@ class Parser {
       lit.text = parse_quoted();
     } else if (std::isdigit(static_cast<unsigned char>(c)) || c == '-' || c == '+' || c == '.') {
       lit.kind = Literal::Kind::Number;
+      const size_t from = pos_;
       lit.number = parse_number_token("the comparison");
+      // An integer literal is exact: beyond 2^53 it is kept as an integer.
+      double d;
+      ExactInt exact;
+      if (integer_literal(std::string_view(s_).substr(from, pos_ - from), d, exact)) lit.number = d, lit.exact = exact;
     } else if (is_ident_start(c)) {
       size_t start = pos_;
       while (is_ident_char(peek())) ++pos_;

@@ -155,18 +155,18 @@ TEST(DataMonitor, DenseOnceOfTheSameIdWithinOneSecond) {
 TEST(BoundValues, KeepTheirJsonType) {
   io::BoundValues ids;
   using io::FieldValue, io::ValueKind;
-  const uint32_t s3 = ids.id(FieldValue{ValueKind::String, false, 0, "3"});
-  const uint32_t n3 = ids.id(FieldValue{ValueKind::Number, false, 3, {}});
-  const uint32_t n30 = ids.id(FieldValue{ValueKind::Number, false, 3.0, {}});
-  const uint32_t t = ids.id(FieldValue{ValueKind::Bool, true, 0, {}});
-  const uint32_t zero = ids.id(FieldValue{ValueKind::Number, false, 0.0, {}});
-  const uint32_t minus_zero = ids.id(FieldValue{ValueKind::Number, false, -0.0, {}});
+  const uint32_t s3 = ids.id(FieldValue{ValueKind::String, false, 0, "3", {}});
+  const uint32_t n3 = ids.id(FieldValue{ValueKind::Number, false, 3, {}, {}});
+  const uint32_t n30 = ids.id(FieldValue{ValueKind::Number, false, 3.0, {}, {}});
+  const uint32_t t = ids.id(FieldValue{ValueKind::Bool, true, 0, {}, {}});
+  const uint32_t zero = ids.id(FieldValue{ValueKind::Number, false, 0.0, {}, {}});
+  const uint32_t minus_zero = ids.id(FieldValue{ValueKind::Number, false, -0.0, {}, {}});
   EXPECT_NE(s3, n3);
   EXPECT_EQ(n3, n30);
   EXPECT_NE(t, n3);
   EXPECT_EQ(zero, minus_zero);
-  EXPECT_EQ(ids.id(FieldValue{ValueKind::Null, false, 0, {}}), 0u);
-  EXPECT_EQ(ids.id(FieldValue{ValueKind::Object, false, 0, {}}), 0u);
+  EXPECT_EQ(ids.id(FieldValue{ValueKind::Null, false, 0, {}, {}}), 0u);
+  EXPECT_EQ(ids.id(FieldValue{ValueKind::Object, false, 0, {}, {}}), 0u);
   EXPECT_EQ(ids.size(), 4u);
 }
 
@@ -174,10 +174,10 @@ TEST(BoundValues, KeepTheirJsonType) {
 TEST(BoundValues, NameTheirValuesAsJson) {
   io::BoundValues ids;
   using io::FieldValue, io::ValueKind;
-  const uint32_t s = ids.id(FieldValue{ValueKind::String, false, 0, "a \"b\"\\c"});
-  const uint32_t n = ids.id(FieldValue{ValueKind::Number, false, 2.5, {}});
-  const uint32_t f = ids.id(FieldValue{ValueKind::Bool, false, 0, {}});
-  const uint32_t digits = ids.id(FieldValue{ValueKind::String, false, 0, "3"});
+  const uint32_t s = ids.id(FieldValue{ValueKind::String, false, 0, "a \"b\"\\c", {}});
+  const uint32_t n = ids.id(FieldValue{ValueKind::Number, false, 2.5, {}, {}});
+  const uint32_t f = ids.id(FieldValue{ValueKind::Bool, false, 0, {}, {}});
+  const uint32_t digits = ids.id(FieldValue{ValueKind::String, false, 0, "3", {}});
   EXPECT_EQ(ids.json(s), R"("a \"b\"\\c")");
   EXPECT_EQ(ids.json(n), "2.5");
   EXPECT_EQ(ids.json(f), "false");
