@@ -163,6 +163,7 @@ struct MonitorCommand {
     if (results)  // a bad spec ends the run before any result, as without a database
       runtime::check_specs(properties, check.dense);
     start_results({input}, properties);
+    for (const auto& dir : typed.msg_paths) typed.registry.add_search_path(dir);  // what the schemas leave out
     BagRun run = cli::run_bag(path, topics, properties, popts, sync, typed.registry, verdicts);
     std::fprintf(stderr, "rvc monitor: %s\n", run.description.c_str());
     const std::string stats = io::JsonObject()

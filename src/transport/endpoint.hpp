@@ -24,6 +24,10 @@ class Source {
   virtual void start(FrameHandler handler) = 0;
   // Stops delivery; no handler call is running or will run after it returns.
   virtual void stop() = 0;
+  // What the transport knows about why messages may not arrive (a publisher
+  // whose QoS this subscriber cannot match), for the end-of-run report; empty
+  // if nothing is known.
+  virtual std::string diagnosis() const { return {}; }
 };
 
 class Sink {
