@@ -162,7 +162,7 @@ Runner register_check(CLI::App& app) {
                   "share/ tree or a plain folder) or one .idl file (repeatable)");
   cmd->sync.add_to(*sub);
   sub->add_option("--output,-o", cmd->outputs,
-                  "Where verdicts go: PATH, file:PATH or - (stdout, the default); also a results database: "
+                  "Where verdicts go: PATH, file:PATH or - (stdout, the default); repeatable for results databases: "
                   "sqlite:PATH or postgresql://... (docs/results.md)");
   cmd->store.add_to(*sub);
   sub->add_flag("--summary", cmd->summary, "Print message counts to stderr at the end");

@@ -460,6 +460,9 @@ Runner register_monitor(CLI::App& app) {
   cmd->typed.add_to(*sub,
                     "Message type of the input's CDR payloads: ROS 2 pkg/msg/Name (`rvc msg list`, `rvc msg show`) or a DDS IDL name from --msg-path; "
                     "several inputs: after the --input it is for, or NAME=pkg/msg/Name");
+  sub->get_option("--msg-path")
+      ->description("Folder of .msg/.idl definitions (a ROS 2 share/ tree or a plain folder), or one .idl file "
+                    "(repeatable): for --type, and for --input mcap:BAG the types its schemas name but do not define");
   cmd->sync.add_to(*sub);
   sub->add_option("--topic", cmd->topics,
                   "With --input mcap:BAG: the topic to check (if the bag holds several); repeatable: NAME=TOPIC, "
