@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# README command 1: install what is missing, build, and run the main job on
+# README command 1: install what is missing, build rvc, and run the main job on
 # the embedded default — no containers, loopback only:
 #   rvc timescales -> trace.jsonl
 #   rvc replay trace.jsonl --to zenoh:rv/timescales   (publisher)
@@ -12,8 +12,12 @@ set -euo pipefail
 DASHBOARD=0
 [ "${1:-}" = "--dashboard" ] && DASHBOARD=1
 cd "$(dirname "$0")/.."
-bash scripts/install-deps.sh
-bash scripts/build.sh
+# Only what the demo needs (the test tiers' tools come with scripts/test.sh), and only the rvc
+# binary: the unit tests, benchmarks and test helpers are built by scripts/test.sh.
+bash scripts/install-deps.sh --demo
+. scripts/cache-env.sh  # ~/.cache/rvc: cargo target keyed by Cargo.lock, ccache
+cmake --preset release >/dev/null
+cmake --build --preset release --target rvc
 RVC=build/release/rvc
 OUT=build/demo
 mkdir -p "$OUT"

@@ -1,23 +1,41 @@
 #!/usr/bin/env bash
 # Installs what rvc needs on Debian bookworm, by package name, from the
 # registries this project may use: Debian packages, PyPI, crates.io (cargo
-# fetches the Zenoh crate at build time). Idempotent: a second run is fast.
+# fetches the Zenoh crate at build time), npm (the browser tests' driver).
+# Idempotent: a second run is fast.
+#   scripts/install-deps.sh          everything: what the demo needs and every test tier's oracles
+#   scripts/install-deps.sh --demo   only what building rvc and running scripts/demo.sh need
 set -euo pipefail
+
+DEMO_ONLY=0
+case "${1:-}" in
+  --demo) DEMO_ONLY=1 ;;
+  "") ;;
+  *) echo "install-deps: unknown option '$1' (--demo: only what the demo needs)" >&2; exit 2 ;;
+esac
 
 SUDO=""
 if [ "$(id -u)" != 0 ]; then SUDO="sudo"; fi
 
+# Building rvc (configuring the release preset needs GoogleTest's and Google Benchmark's CMake
+# packages too, small header/static-library packages) and running the demo (python3 picks a free port).
 APT_PACKAGES=(
   build-essential cmake ninja-build pkg-config git ccache
   libsimdjson-dev libcli11-dev libyaml-cpp-dev libgtest-dev libgmock-dev libbenchmark-dev
-  libsqlite3-dev libpq-dev postgresql  # results store: SQLite embedded, PostgreSQL (tests start their own server)
+  libsqlite3-dev libpq-dev              # results store: SQLite embedded, libpq's header (loaded on use)
   libcpp-httplib-dev                    # rvc dashboard's HTTP server
+  cyclonedds-dev cyclonedds-tools       # DDS transport (idlc generates its type support)
+  python3
+)
+# The test tiers' oracles and tools on top (docs/testing.md).
+TEST_APT_PACKAGES=(
+  postgresql                            # a real PostgreSQL server (tests start their own)
   chromium                              # the dashboard's browser tests (Playwright drives it)
-  cyclonedds-dev cyclonedds-tools
-  python3 python3-pip
+  python3-pip
   iproute2 time
   clang libclang-rt-14-dev  # libFuzzer harnesses and the sanitizer tiers (tests/fuzz)
 )
+if [ "$DEMO_ONLY" = 0 ]; then APT_PACKAGES+=("${TEST_APT_PACKAGES[@]}"); fi
 # Zenoh is a Rust crate: the locked Zenoh dependencies need cargo >= 1.89; Debian's cargo-web (1.96)
 # is used when the machine has none.
 need_rust=1
@@ -35,6 +53,11 @@ if [ "${#missing[@]}" -gt 0 ]; then
   echo "install-deps: apt packages: ${missing[*]}"
   $SUDO apt-get update -qq
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+
+if [ "$DEMO_ONLY" = 1 ]; then
+  echo "install-deps: ok (demo set; scripts/install-deps.sh without --demo adds the test tiers' tools)"
+  exit 0
 fi
 
 # Python test oracles and peers: Reelay (the reference monitors), the official

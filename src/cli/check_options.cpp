@@ -12,7 +12,8 @@ void CheckOptions::add_to(CLI::App& app) {
   app.add_flag("--all", all, "Report the verdict at every step, not only changes");
   app.add_flag("--robustness", robustness,
                "Report robustness values (Reelay's quantitative semantics: how far from changing the verdict; "
-               "positive holds) instead of true/false; JSON input (docs/semantics.md)");
+               "positive holds) instead of true/false; discrete and dense time, JSON and typed input, one input (not several "
+               "synchronized ones) (docs/semantics.md)");
   app.add_flag("--explain", explain,
                "With each violation, say why: the sub-formulas and steps (dense: intervals) that made the verdict "
                "false, and for data references the value that decided");

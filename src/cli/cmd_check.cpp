@@ -36,6 +36,7 @@ struct CheckCommand {
   bool summary = false;
   bool stats = false;  // --stats: the counters as one JSON line on stderr, as the monitor's
   std::vector<std::string> topics;  // --topic: which topic(s) of a bag
+  std::vector<std::string> msg_paths;  // --msg-path: definitions a bag's schemas leave out
   SyncFlags sync;                   // several topics
   msg::TypeRegistry registry;  // types from a bag's schemas
 
@@ -55,8 +56,9 @@ struct CheckCommand {
     }
     const bool bag = input.rfind("mcap:", 0) == 0;
     if (bag || (path != "-" && is_bag(path))) return run_bag(properties, bag ? input.substr(5) : path, opath);
-    if (!topics.empty()) {
-      std::fprintf(stderr, "rvc: --topic chooses a topic of a bag (MCAP); '%s' is a JSON-lines trace\n",
+    if (!topics.empty() || !msg_paths.empty()) {
+      std::fprintf(stderr, "rvc: %s a bag (MCAP); '%s' is a JSON-lines trace\n",
+                   topics.empty() ? "--msg-path gives the message definitions of" : "--topic chooses a topic of",
                    path.c_str());
       return kUsage;
     }
@@ -123,6 +125,7 @@ struct CheckCommand {
   int run_bag(const std::vector<engine::PropertySpec>& properties, const std::string& path,
               const std::string& opath) {
 #ifdef RVC_HAVE_MCAP
+    for (const auto& dir : msg_paths) registry.add_search_path(dir);
     std::vector<std::unique_ptr<transport::Sink>> sinks;
     sinks.push_back(std::make_unique<transport::FileSink>(opath));
     runtime::VerdictOutputs outputs(std::move(sinks), !check.dense);
@@ -194,9 +197,12 @@ Runner register_check(CLI::App& app) {
   sub->add_option("--topic", cmd->topics,
                   "The topic of a bag to check (needed when the bag holds several); repeatable: NAME=TOPIC (or TOPIC, "
                   "named by its last part), synchronized by --sync, tested as {NAME.field}");
+  sub->add_option("--msg-path", cmd->msg_paths,
+                  "A bag's types that its schemas name but do not define: a folder of .msg/.idl definitions (a ROS 2 "
+                  "share/ tree or a plain folder) or one .idl file (repeatable)");
   cmd->sync.add_to(*sub);
   sub->add_option("--output,-o", cmd->outputs,
-                  "Where verdicts go: PATH, file:PATH or - (stdout, the default); also a results database: "
+                  "Where verdicts go: PATH, file:PATH or - (stdout, the default); repeatable for results databases: "
                   "sqlite:PATH or postgresql://... (docs/results.md)");
   cmd->store.add_to(*sub);
   sub->add_flag("--summary", cmd->summary, "Print message counts to stderr at the end");

@@ -132,6 +132,10 @@ struct EchoCommand {
                    rejected == 1 ? "" : "s");
       return kBadInput;
     }
+    if (printed == 0) {
+      const std::string why = source->diagnosis();  // a publisher with incompatible QoS, say
+      if (!why.empty()) std::fprintf(stderr, "rvc: nothing was received on %s; %s\n", input.c_str(), why.c_str());
+    }
     return printed == 0 ? kIncomplete : kOk;
   }
 };

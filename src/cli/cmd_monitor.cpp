@@ -176,6 +176,7 @@ struct MonitorCommand {
     if (results)  // a bad spec ends the run before any result, as without a database
       runtime::check_specs(properties, check.dense);
     start_results({input}, properties);
+    for (const auto& dir : typed.msg_paths) typed.registry.add_search_path(dir);  // what the schemas leave out
     BagRun run = cli::run_bag(path, topics, properties, popts, sync, typed.registry, verdicts);
     std::fprintf(stderr, "rvc monitor: %s\n", run.description.c_str());
     const std::string stats = io::JsonObject()
@@ -478,6 +479,9 @@ Runner register_monitor(CLI::App& app) {
   cmd->typed.add_to(*sub,
                     "Message type of the input's CDR payloads: ROS 2 pkg/msg/Name (`rvc msg list`, `rvc msg show`) or a DDS IDL name from --msg-path; "
                     "several inputs: after the --input it is for, or NAME=pkg/msg/Name");
+  sub->get_option("--msg-path")
+      ->description("Folder of .msg/.idl definitions (a ROS 2 share/ tree or a plain folder), or one .idl file "
+                    "(repeatable): for --type, and for --input mcap:BAG the types its schemas name but do not define");
   cmd->sync.add_to(*sub);
   sub->add_option("--topic", cmd->topics,
                   "With --input mcap:BAG: the topic to check (if the bag holds several); repeatable: NAME=TOPIC, "

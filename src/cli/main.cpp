@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "cli/commands.hpp"
+#include "cli/option_rules.hpp"
 #include "cli/store_options.hpp"
 #include "msg/msg_types.hpp"
 #include "io/properties_file.hpp"
@@ -62,10 +63,22 @@ int main(int argc, char** argv) {
                                [&](const auto& s) { return first == s.first; });
   for (const auto& [name, add] : kSubcommands)
     if (!one || first == name) runners[name] = add(app);
+  one_value_per_flag(app);
+  // Hidden, for tests: how the command line is read (option_rules.hpp).
+  if (first == "--list-repeatable") {
+    std::fputs(repeatable_options_json(app).c_str(), stdout);
+    return 0;
+  }
+  bool print_parsed = false;
+  app.add_flag("--print-parsed", print_parsed, "Print how the command line was read, run nothing")->group("");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? 0 : kUsage;
+  }
+  if (print_parsed) {
+    std::printf("%s\n", parsed_json(app).c_str());
+    return 0;
   }
   try {
     for (CLI::App* sub : app.get_subcommands()) {

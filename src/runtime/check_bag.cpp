@@ -47,13 +47,21 @@ BagInput select_bag_topic(const std::string& path, const std::string& topic, msg
   if (t.message_encoding != "cdr")
     throw std::invalid_argument("topic '" + in.topic + "' of bag '" + path + "' is encoded as '" +
                                 t.message_encoding + "': rvc reads ROS 2 CDR and JSON messages");
-  if (t.schema_encoding == "ros2msg")
-    registry.add_concatenated(t.schema_name, t.schema, "schema of " + in.topic + " in " + path);
-  else if (t.schema_encoding == "ros2idl")  // types defined in .idl only (rosbag2 records them so)
-    registry.add_concatenated_idl(t.schema, "schema of " + in.topic + " in " + path);
-  else
+  if (t.schema_name.empty())
+    throw std::invalid_argument("topic '" + in.topic + "' of bag '" + path +
+                                "' has no schema: the bag does not say which type its CDR messages are");
+  // A schema may name the type and hold no definition (some writers record
+  // only the name): then the type comes from --msg-path or the bundled
+  // definitions, as does any type a schema uses but leaves out.
+  const bool defined = t.schema.find_first_not_of(" \t\r\n") != std::string::npos;
+  if (t.schema_encoding == "ros2msg") {
+    if (defined) registry.add_concatenated(t.schema_name, t.schema, "schema of " + in.topic + " in " + path);
+  } else if (t.schema_encoding == "ros2idl") {  // types defined in .idl only (rosbag2 records them so)
+    if (defined) registry.add_concatenated_idl(t.schema, "schema of " + in.topic + " in " + path);
+  } else {
     throw std::invalid_argument("topic '" + in.topic + "' of bag '" + path + "' has a '" + t.schema_encoding +
                                 "' schema: rvc reads ROS 2 schemas (ros2msg, ros2idl)");
+  }
   in.type = &registry.resolve(t.schema_name);
   return in;
 }

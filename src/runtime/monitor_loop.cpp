@@ -308,15 +308,20 @@ Outcome MonitorLoop::run(const std::vector<transport::Source*>& sources) {
   // the publisher's end-of-stream marker) it ended some other way.
   if (end_ != EndReason::Failed) {
     if (total(&transport::SeqCounters::received) == 0) {
-      std::fprintf(stderr, "rvc: nothing was received on %s (ended by %s): nothing was checked\n",
-                   options_.input.c_str(), to_string(end_));
+      std::string why;  // a transport's reason, such as a publisher with incompatible QoS
+      for (const transport::Source* s : sources)
+        if (std::string d = s->diagnosis(); !d.empty()) why += "; " + d;
+      std::fprintf(stderr, "rvc: nothing was received on %s (ended by %s): nothing was checked%s\n",
+                   options_.input.c_str(), to_string(end_), why.c_str());
       outcome.incomplete = true;
     } else if (!options_.input_names.empty() && !eos_ &&
                std::any_of(counters_.begin(), counters_.end(), [](const auto& c) { return c.received == 0; })) {
       for (size_t i = 0; i < counters_.size(); ++i)
-        if (counters_[i].received == 0)
-          std::fprintf(stderr, "rvc: nothing was received on input '%s' (ended by %s): sets needing it never formed\n",
-                       options_.input_names[i].c_str(), to_string(end_));
+        if (counters_[i].received == 0) {
+          const std::string d = i < sources.size() ? sources[i]->diagnosis() : std::string();
+          std::fprintf(stderr, "rvc: nothing was received on input '%s' (ended by %s): sets needing it never formed%s\n",
+                       options_.input_names[i].c_str(), to_string(end_), d.empty() ? "" : ("; " + d).c_str());
+        }
       outcome.incomplete = true;
     } else if (options_.exit_on_eos && !eos_) {
       std::fprintf(stderr, "rvc: %s ended by %s before the publisher's end-of-stream marker: the stream is incomplete\n",

@@ -37,6 +37,10 @@ class Source {
     (void)frame;
     return PullResult::End;
   }
+  // What the transport knows about why messages may not arrive (a publisher
+  // whose QoS this subscriber cannot match), for the end-of-run report; empty
+  // if nothing is known.
+  virtual std::string diagnosis() const { return {}; }
 };
 
 class Sink {

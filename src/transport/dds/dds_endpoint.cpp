@@ -12,6 +12,7 @@
 #include <exception>
 #include <map>
 #include <mutex>
+#include <set>
 #include <stdexcept>
 #include <thread>
 #include <unordered_map>
@@ -192,6 +193,45 @@ bool wait_status(dds_entity_t participant, dds_entity_t entity, uint32_t mask, G
   return ok;
 }
 
+// A QoS policy by the name the DDS specification gives it.
+const char* policy_name(uint32_t id) {
+  switch (id) {
+    case DDS_USERDATA_QOS_POLICY_ID: return "USER_DATA";
+    case DDS_DURABILITY_QOS_POLICY_ID: return "DURABILITY";
+    case DDS_PRESENTATION_QOS_POLICY_ID: return "PRESENTATION";
+    case DDS_DEADLINE_QOS_POLICY_ID: return "DEADLINE";
+    case DDS_LATENCYBUDGET_QOS_POLICY_ID: return "LATENCY_BUDGET";
+    case DDS_OWNERSHIP_QOS_POLICY_ID: return "OWNERSHIP";
+    case DDS_OWNERSHIPSTRENGTH_QOS_POLICY_ID: return "OWNERSHIP_STRENGTH";
+    case DDS_LIVELINESS_QOS_POLICY_ID: return "LIVELINESS";
+    case DDS_TIMEBASEDFILTER_QOS_POLICY_ID: return "TIME_BASED_FILTER";
+    case DDS_PARTITION_QOS_POLICY_ID: return "PARTITION";
+    case DDS_RELIABILITY_QOS_POLICY_ID: return "RELIABILITY";
+    case DDS_DESTINATIONORDER_QOS_POLICY_ID: return "DESTINATION_ORDER";
+    case DDS_HISTORY_QOS_POLICY_ID: return "HISTORY";
+    case DDS_RESOURCELIMITS_QOS_POLICY_ID: return "RESOURCE_LIMITS";
+    case DDS_TOPICDATA_QOS_POLICY_ID: return "TOPIC_DATA";
+    case DDS_GROUPDATA_QOS_POLICY_ID: return "GROUP_DATA";
+    case DDS_TRANSPORTPRIORITY_QOS_POLICY_ID: return "TRANSPORT_PRIORITY";
+    case DDS_LIFESPAN_QOS_POLICY_ID: return "LIFESPAN";
+    case DDS_DURABILITYSERVICE_QOS_POLICY_ID: return "DURABILITY_SERVICE";
+    case DDS_TYPE_CONSISTENCY_ENFORCEMENT_QOS_POLICY_ID: return "TYPE_CONSISTENCY_ENFORCEMENT";
+    case DDS_DATA_REPRESENTATION_QOS_POLICY_ID: return "DATA_REPRESENTATION";
+    default: return "an unknown policy";
+  }
+}
+
+// "RELIABILITY (rvc requests reliable; --qos best-effort accepts it)": the
+// policy, and for the two that --qos sets, what rvc's reader asks for.
+std::string incompatible_policy(uint32_t id, const QosSpec& q) {
+  std::string s = policy_name(id);
+  if (id == DDS_RELIABILITY_QOS_POLICY_ID && q.reliable)
+    s += " (rvc requests reliable; --qos best-effort accepts a best-effort publisher)";
+  else if (id == DDS_DURABILITY_QOS_POLICY_ID && q.transient_local)
+    s += " (rvc requests transient-local; --qos volatile accepts a volatile publisher)";
+  return s;
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------- DdsSource
@@ -209,10 +249,19 @@ struct DdsSource::Impl {
   std::mutex drain_mu;
   std::atomic<std::thread::id> draining{};
   std::unordered_map<dds_instance_handle_t, uint64_t> arrivals;  // per writer (String type)
+  const std::string uri;                      // dds:TOPIC as the user wrote it
+  mutable std::mutex qos_mu;                  // CycloneDDS calls the listener on its own threads
+  std::set<uint32_t> incompatible_policies;  // said once each
+  std::string incompatible;                   // "a publisher's QoS is incompatible ...", for diagnosis()
 
-  Impl(const std::string& topic, const DdsOptions& o) : ep(topic, o, false), on_receive_thread(o.deliver_on_receive_thread) {
+  Impl(const std::string& topic, const DdsOptions& o)
+      : ep(topic, o, false), on_receive_thread(o.deliver_on_receive_thread), uri("dds:" + topic) {
     dds_qos_t* rq = make_qos(ep.qos, o.partition, false);
-    reader = ddsc().dds_create_reader(ep.group, ep.topic, rq, nullptr);
+    // From creation on: a writer found while the reader is being made counts too.
+    dds_listener_t* l = ddsc().dds_create_listener(this);
+    ddsc().dds_lset_requested_incompatible_qos(l, &Impl::on_incompatible_qos);
+    reader = ddsc().dds_create_reader(ep.group, ep.topic, rq, l);
+    ddsc().dds_delete_listener(l);
     ddsc().dds_delete_qos(rq);
     if (reader < 0) fail("cannot create reader on '" + ep.name + "'", reader);
     if (on_receive_thread) return;
@@ -346,6 +395,20 @@ struct DdsSource::Impl {
 
   static void on_data_available(dds_entity_t, void* arg) { static_cast<Impl*>(arg)->drain(); }
 
+  // A writer on the topic that this reader cannot match (its QoS offers less
+  // than the reader requests): CycloneDDS never delivers its samples, so the
+  // run would otherwise end with "nothing was received" and no reason. The
+  // status names the last policy found at fault; each is said once.
+  static void on_incompatible_qos(dds_entity_t, const dds_requested_incompatible_qos_status_t st, void* arg) {
+    auto* self = static_cast<Impl*>(arg);
+    std::lock_guard lock(self->qos_mu);
+    if (!self->incompatible_policies.insert(st.last_policy_id).second) return;
+    const std::string policy = incompatible_policy(st.last_policy_id, self->ep.qos);
+    std::fprintf(stderr, "rvc: %s: a publisher's QoS is incompatible with rvc's reader: %s; its messages are not received\n",
+                 self->uri.c_str(), policy.c_str());
+    self->incompatible += (self->incompatible.empty() ? "" : ", ") + policy;
+  }
+
   // Thread mode: the source's own thread sleeps on a waitset.
   void run() {
     while (!stop_requested.load()) {
@@ -368,6 +431,7 @@ void DdsSource::start(FrameHandler handler) {
   }
   dds_listener_t* l = ddsc().dds_create_listener(impl_.get());
   ddsc().dds_lset_data_available(l, &Impl::on_data_available);
+  ddsc().dds_lset_requested_incompatible_qos(l, &Impl::on_incompatible_qos);  // set_listener replaces them all
   dds_return_t rc = ddsc().dds_set_listener(impl_->reader, l);
   ddsc().dds_delete_listener(l);
   if (rc < 0) fail("cannot set the data listener on '" + impl_->ep.name + "'", rc);
@@ -404,6 +468,12 @@ bool DdsSource::wait_matched(size_t n, std::chrono::milliseconds timeout) {
 }
 
 const std::string& DdsSource::dds_topic() const { return impl_->ep.name; }
+
+std::string DdsSource::diagnosis() const {
+  std::lock_guard lock(impl_->qos_mu);
+  if (impl_->incompatible.empty()) return {};
+  return impl_->uri + ": a publisher's QoS is incompatible with rvc's reader: " + impl_->incompatible;
+}
 
 // ------------------------------------------------------------------ DdsSink
 

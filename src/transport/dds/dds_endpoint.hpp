@@ -41,6 +41,9 @@ class DdsSource final : public Source {
 
   // Waits until at least n writers match this reader; false on timeout.
   bool wait_matched(size_t n, std::chrono::milliseconds timeout);
+  // The QoS policies that kept writers from matching this reader, each
+  // also said on stderr as soon as CycloneDDS reports it.
+  std::string diagnosis() const override;
   const std::string& dds_topic() const;
 
  private:

@@ -19,7 +19,7 @@ inline constexpr const char* kDdscSoname = RVC_DDSC_SONAME;
   X(dds_create_publisher) X(dds_create_qos) X(dds_create_readcondition) X(dds_create_reader) \
   X(dds_create_subscriber) X(dds_create_topic) X(dds_create_waitset) X(dds_create_writer) X(dds_delete) \
   X(dds_delete_listener) X(dds_delete_qos) X(dds_get_publication_matched_status) \
-  X(dds_get_subscription_matched_status) X(dds_istream_fini) X(dds_istream_init) \
+  X(dds_get_subscription_matched_status) X(dds_lset_requested_incompatible_qos) X(dds_istream_fini) X(dds_istream_init) \
   X(dds_lset_data_available) X(dds_qset_durability) X(dds_qset_durability_service) X(dds_qset_entity_name) \
   X(dds_qset_history) X(dds_qset_partition1) X(dds_qset_reliability) X(dds_qset_resource_limits) \
   X(dds_return_loan) X(dds_set_guardcondition) X(dds_set_listener) X(dds_set_status_mask) \
