@@ -15,6 +15,9 @@
 # compiled dependencies survive between builds of the same tree; cargo's
 # parallelism follows RVC_CARGO_JOBS (default 2, the size of our machines).
 #
+# A shared target dir is claimed by the checkout that builds (CargoClaim.cmake),
+# so one checkout never links a library cargo built from another's sources.
+#
 # Ninja reruns cargo only when a file under src/, Cargo.toml or Cargo.lock
 # changes (the stamp below); cargo then does its own fine-grained check.
 
@@ -66,12 +69,18 @@ function(rvc_cargo_staticlib target)
   set(lib "${target_dir}/release/lib${ARG_LIB_NAME}.a")
   set(stamp "${CMAKE_CURRENT_BINARY_DIR}/${target}.cargo-stamp")
 
+  # The [package] name, for CargoClaim.cmake (the first `name =` line).
+  file(STRINGS "${manifest_dir}/Cargo.toml" name_line REGEX "^name *= *\"" LIMIT_COUNT 1)
+  string(REGEX REPLACE "^name *= *\"([^\"]+)\".*" "\\1" package "${name_line}")
+
   file(GLOB_RECURSE sources CONFIGURE_DEPENDS
     "${manifest_dir}/src/*.rs" "${manifest_dir}/build.rs")
 
   add_custom_command(
     OUTPUT "${stamp}"
     BYPRODUCTS "${lib}"
+    COMMAND "${CMAKE_COMMAND}" "-DTARGET_DIR=${target_dir}" "-DMANIFEST_DIR=${manifest_dir}"
+            "-DPACKAGE=${package}" -P "${PROJECT_SOURCE_DIR}/cmake/CargoClaim.cmake"
     COMMAND "${CMAKE_COMMAND}" -E env
             "CARGO_TARGET_DIR=${target_dir}" "CARGO_BUILD_JOBS=${RVC_CARGO_JOBS}"
             "${CARGO_EXECUTABLE}" build --locked --release -j ${RVC_CARGO_JOBS}
