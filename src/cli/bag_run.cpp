@@ -46,4 +46,19 @@ BagRun run_bag(const std::string& path, const std::vector<std::string>& topics,
   return run;
 }
 
+std::string BagRun::counters_json(const std::string& input, uint64_t verdicts) const {
+  return io::JsonObject()
+      .add("input", input)
+      .add("topic", topic)
+      .add("messages", messages)
+      .add("received", received)
+      .add("checked", stats.accepted)
+      .add("rejected", stats.rejected)
+      .add("dropped", dropped)
+      .add("warnings", stats.warnings)
+      .add("verdicts", verdicts)
+      .add("violations", violations)
+      .str();
+}
+
 }  // namespace rvc::cli

@@ -23,6 +23,10 @@ struct BagRun {
   io::JsonObject dropped;   // by the synchronizer, by reason
   std::string topic;        // the chosen topic (several: joined by ",")
   std::string description;  // "topic /a (pkg/msg/T, 12 messages)", or the inputs
+
+  // The run's counters as one JSON object, the fields of the monitor's line
+  // (received = checked + rejected + dropped), for `check --stats` and `monitor`.
+  std::string counters_json(const std::string& input, uint64_t verdicts) const;
 };
 
 // Throws as select_bag_topic(s) for a bad choice of topics; `sync` applies

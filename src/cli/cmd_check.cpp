@@ -141,20 +141,7 @@ struct CheckCommand {
     BagRun run = cli::run_bag(path, topics, properties, popts, sync, registry, outputs);
     if (summary) std::fprintf(stderr, "rvc check: %s, %s\n", path.c_str(), run.description.c_str());
     report(run.stats, run.violations);
-    if (stats) {
-      const std::string counters = io::JsonObject()
-                                       .add("input", input)
-                                       .add("topic", run.topic)
-                                       .add("received", run.received)
-                                       .add("checked", run.stats.accepted)
-                                       .add("rejected", run.stats.rejected)
-                                       .add("dropped", run.dropped)
-                                       .add("warnings", run.stats.warnings)
-                                       .add("verdicts", outputs.count())
-                                       .add("violations", run.violations)
-                                       .str();
-      std::fprintf(stderr, "%s\n", counters.c_str());
-    }
+    if (stats) std::fprintf(stderr, "%s\n", run.counters_json(input, outputs.count()).c_str());
     if (results) results->finish(run.outcome, "end of bag", counters_json(run.stats, run.violations));
     return run.outcome.exit_code();
 #else

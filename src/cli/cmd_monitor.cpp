@@ -179,18 +179,7 @@ struct MonitorCommand {
     for (const auto& dir : typed.msg_paths) typed.registry.add_search_path(dir);  // what the schemas leave out
     BagRun run = cli::run_bag(path, topics, properties, popts, sync, typed.registry, verdicts);
     std::fprintf(stderr, "rvc monitor: %s\n", run.description.c_str());
-    const std::string stats = io::JsonObject()
-                                  .add("input", input)
-                                  .add("topic", run.topic)
-                                  .add("messages", run.messages)
-                                  .add("received", run.received)
-                                  .add("checked", run.stats.accepted)
-                                  .add("rejected", run.stats.rejected)
-                                  .add("dropped", run.dropped)
-                                  .add("warnings", run.stats.warnings)
-                                  .add("verdicts", verdicts.count())
-                                  .add("violations", run.violations)
-                                  .str();
+    const std::string stats = run.counters_json(input, verdicts.count());
     std::fprintf(stderr, "%s\n", stats.c_str());
     if (results) results->finish(run.outcome, "end of bag", stats);
     return finish_enforcer(run.outcome.exit_code());
