@@ -1,11 +1,14 @@
 #include "cli/bag_run.hpp"
 
+#include "cli/signals.hpp"
+
 namespace rvc::cli {
 
 BagRun run_bag(const std::string& path, const std::vector<std::string>& topics,
                const std::vector<engine::PropertySpec>& properties, runtime::PipelineOptions options,
                const SyncFlags& sync, msg::TypeRegistry& registry, runtime::VerdictOutputs& outputs) {
   BagRun run;
+  install_stop_signals();
   options.position_name = "message";
   auto on_verdict = [&](const engine::Verdict& v) { outputs.put(v); };
   if (topics.size() <= 1 && (topics.empty() || topics[0].find('=') == std::string::npos || topics[0][0] == '/')) {
@@ -17,7 +20,8 @@ BagRun run_bag(const std::string& path, const std::vector<std::string>& topics,
     run.description = "topic " + bag.topic + " (" + (bag.type ? bag.type->full_name() : std::string("JSON")) + ", " +
                       std::to_string(bag.messages) + " messages)";
     uint64_t skipped = 0;
-    run.outcome = runtime::check_bag({bag}, pipeline, outputs, skipped);
+    run.outcome = runtime::check_bag({bag}, pipeline, outputs, skipped, stop_requested);
+    run.stopped = stop_requested();
     run.stats = pipeline.stats();
     run.stats.rejected += skipped;  // the bag's bad records: rejected input like a malformed message
     run.violations = pipeline.violations();
@@ -37,7 +41,8 @@ BagRun run_bag(const std::string& path, const std::vector<std::string>& topics,
   }
   run.description += std::string(", sync ") + sync::to_string(sync.options(inputs).policy);
   uint64_t skipped = 0;
-  run.outcome = runtime::check_bag(bags, pipeline, outputs, skipped);
+  run.outcome = runtime::check_bag(bags, pipeline, outputs, skipped, stop_requested);
+  run.stopped = stop_requested();
   run.stats = pipeline.stats();
   run.stats.rejected += skipped;
   run.violations = pipeline.violations();

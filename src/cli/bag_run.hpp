@@ -23,6 +23,7 @@ struct BagRun {
   io::JsonObject dropped;   // by the synchronizer, by reason
   std::string topic;        // the chosen topic (several: joined by ",")
   std::string description;  // "topic /a (pkg/msg/T, 12 messages)", or the inputs
+  bool stopped = false;     // a stop signal ended the bag before its end
 
   // The run's counters as one JSON object, the fields of the monitor's line
   // (received = checked + rejected + dropped), for `check --stats` and `monitor`.
@@ -30,7 +31,8 @@ struct BagRun {
 };
 
 // Throws as select_bag_topic(s) for a bad choice of topics; `sync` applies
-// with several topics.
+// with several topics. SIGINT/SIGTERM end the bag where it is (what was read
+// is checked; the outcome is incomplete), as they end every other input.
 BagRun run_bag(const std::string& path, const std::vector<std::string>& topics,
                const std::vector<engine::PropertySpec>& properties, runtime::PipelineOptions options,
                const SyncFlags& sync, msg::TypeRegistry& registry, runtime::VerdictOutputs& outputs);

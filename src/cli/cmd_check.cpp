@@ -142,7 +142,7 @@ struct CheckCommand {
     if (summary) std::fprintf(stderr, "rvc check: %s, %s\n", path.c_str(), run.description.c_str());
     report(run.stats, run.violations);
     if (stats) std::fprintf(stderr, "%s\n", run.counters_json(input, outputs.count()).c_str());
-    if (results) results->finish(run.outcome, "end of bag", counters_json(run.stats, run.violations));
+    if (results) results->finish(run.outcome, run.stopped ? "signal" : "end of bag", counters_json(run.stats, run.violations));
     return run.outcome.exit_code();
 #else
     (void)properties;

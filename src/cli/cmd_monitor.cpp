@@ -181,7 +181,7 @@ struct MonitorCommand {
     std::fprintf(stderr, "rvc monitor: %s\n", run.description.c_str());
     const std::string stats = run.counters_json(input, verdicts.count());
     std::fprintf(stderr, "%s\n", stats.c_str());
-    if (results) results->finish(run.outcome, "end of bag", stats);
+    if (results) results->finish(run.outcome, run.stopped ? "signal" : "end of bag", stats);
     return finish_enforcer(run.outcome.exit_code());
 #else
     (void)properties;

@@ -66,7 +66,8 @@ BagInput select_bag_topic(const std::string& path, const std::string& topic, msg
   return in;
 }
 
-Outcome check_bag(const std::vector<BagInput>& inputs, Feed& feed, VerdictOutputs& outputs, uint64_t& skipped) {
+Outcome check_bag(const std::vector<BagInput>& inputs, Feed& feed, VerdictOutputs& outputs, uint64_t& skipped,
+                  const std::function<bool()>& stop) {
   skipped = 0;
   return run_check(feed, outputs, [&](Outcome& outcome) {
     transport::McapBag bag(inputs.at(0).path);
@@ -76,7 +77,14 @@ Outcome check_bag(const std::vector<BagInput>& inputs, Feed& feed, VerdictOutput
       outcome.rejected = true;
     });
     transport::McapMessage m;
-    for (;;) {
+    for (uint64_t n = 0;; ++n) {
+      // Asked every 64 messages: a stop signal ends the bag within microseconds.
+      if (stop && (n & 63) == 0 && stop()) {
+        std::fprintf(stderr, "rvc: stopped by a signal after %llu messages: bag '%s' was not read to its end\n",
+                     static_cast<unsigned long long>(n), bag.path().c_str());
+        outcome.incomplete = true;
+        break;
+      }
       try {
         if (!bag.next(m)) break;
       } catch (const transport::McapError& e) {

@@ -4,6 +4,7 @@
 // carries the .msg text of every type it holds), so no --msg-path is needed.
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -39,7 +40,11 @@ BagInput select_bag_topic(const std::string& path, const std::string& topic, msg
 // channel never defined, ...) is reported with its offset, skipped and
 // counted in `skipped` (the run's rejected input: exit 3 unless a property
 // is violated); the messages around it are still checked.
-Outcome check_bag(const std::vector<BagInput>& inputs, Feed& feed, VerdictOutputs& outputs, uint64_t& skipped);
+// `stop` (may be empty) is asked between messages: when it says so (a stop
+// signal), reading ends there, what was read is checked, and the outcome is
+// incomplete (the bag was not read to its end).
+Outcome check_bag(const std::vector<BagInput>& inputs, Feed& feed, VerdictOutputs& outputs, uint64_t& skipped,
+                  const std::function<bool()>& stop = {});
 
 // Several topics of a bag: "NAME=TOPIC" or "TOPIC" (named by its last part,
 // "/vehicle/status/gear_status" -> gear_status). The inputs to synchronize,
