@@ -16,6 +16,8 @@ import pytest
 
 from conftest import transports_built
 
+pytestmark = pytest.mark.needs_mcap  # every test here reads a bag
+
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 DEFS = os.path.join(ROOT, "src", "msg", "definitions")
 GEAR = "autoware_auto_vehicle_msgs/msg/GearReport"

@@ -13,6 +13,8 @@ import pytest
 
 from conftest import transports_built
 
+pytestmark = pytest.mark.needs_mcap  # every test here reads a bag
+
 PAIR = "int32 a\nfloat64 b\n"
 OUTER = "rvc_test_pkg/Pair inner\nbool ok\n"
 A_VALUES = [1, 5, 9, 2]

@@ -6,6 +6,8 @@ import json
 import random
 import subprocess
 
+import pytest
+
 from test_mcap import typestore  # noqa: F401  (the fixture: rosbags' types for the bag test)
 
 
@@ -102,6 +104,7 @@ def late_bag(tmp_path, typestore):
     return str(next(folder.glob("*.mcap")))
 
 
+@pytest.mark.needs_mcap
 def test_late_messages_of_a_bag_are_warned_counted_and_not_a_pass(rvc, tmp_path, typestore):
     from test_mcap import GEAR_TOPIC, STEER_TOPIC
     bag = late_bag(tmp_path, typestore)
