@@ -7,17 +7,17 @@ from rvc_testlib import (BY_DESIGN, PLATFORM, pytest_make_collect_report, pytest
                          rvc, rvc_binary, transports_built)
 
 
-# Tests that read a ROS 2 bag need the MCAP reader, which lives in the Rust library; the sanitizer
-# tiers build rvc without it (RVC_WITH_ZENOH=OFF) and set RVC_NO_MCAP=1, which deselects exactly
-# these tests (named in the run's summary as deselected, never as passed or skipped).
+# Tests that read a ROS 2 bag or use a zenoh: endpoint need rvc's Rust library (the MCAP reader, the
+# Zenoh transport); the sanitizer tiers build rvc without it (RVC_WITH_ZENOH=OFF) and set
+# RVC_NO_RUST=1, which deselects exactly these tests (counted as deselected, never passed or skipped).
 def pytest_configure(config):
-    config.addinivalue_line("markers", "needs_mcap: reads a ROS 2 bag (MCAP): needs rvc's Rust library")
+    config.addinivalue_line("markers", "needs_rust: reads a ROS 2 bag or uses Zenoh: needs rvc's Rust library")
 
 
 def pytest_collection_modifyitems(config, items):
-    if not os.environ.get("RVC_NO_MCAP"):
+    if not os.environ.get("RVC_NO_RUST"):
         return
-    dropped = [i for i in items if i.get_closest_marker("needs_mcap")]
+    dropped = [i for i in items if i.get_closest_marker("needs_rust")]
     if dropped:
         config.hook.pytest_deselected(items=dropped)
-        items[:] = [i for i in items if not i.get_closest_marker("needs_mcap")]
+        items[:] = [i for i in items if not i.get_closest_marker("needs_rust")]

@@ -16,7 +16,7 @@ import pytest
 from conftest import transports_built
 from test_mcap_hostile import json_bag
 
-pytestmark = pytest.mark.needs_mcap  # every test here reads a bag
+pytestmark = pytest.mark.needs_rust  # every test here reads a bag
 
 MESSAGES = 20_000  # ~45 bytes of verdict each: far more than a pipe's 64 KiB buffer
 

@@ -117,7 +117,7 @@ def sample(ts, row):
     return bytes(ts.serialize_cdr(m, TYPE))
 
 
-@pytest.mark.needs_mcap
+@pytest.mark.needs_rust
 @pytest.mark.parametrize("seed", [4, 5])
 def test_typed_numbers_compare_as_python_compares_them(rvc, tmp_path, seed):
     """The same in CDR samples serialized by rosbags, in a bag rvc reads with its typed decoder."""
@@ -143,7 +143,7 @@ def test_typed_numbers_compare_as_python_compares_them(rvc, tmp_path, seed):
     assert first_difference(got, want, rows, specs) is None, first_difference(got, want, rows, specs)
 
 
-@pytest.mark.needs_mcap  # its last part reads the values from a bag
+@pytest.mark.needs_rust  # its last part reads the values from a bag
 def test_non_finite_floats_round_trip_through_json(rvc, tmp_path):
     """Typed samples with NaN and infinities: `rvc msg decode` writes JSON that Python's json.loads reads
     back to the same values, `rvc msg encode` turns back into the same bytes, and `rvc check` on it gives

@@ -16,7 +16,7 @@ import pytest
 
 from conftest import transports_built
 
-pytestmark = pytest.mark.needs_mcap  # every test here reads a bag
+pytestmark = pytest.mark.needs_rust  # every test here reads a bag
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 DEFS = os.path.join(ROOT, "src", "msg", "definitions")

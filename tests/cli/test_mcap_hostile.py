@@ -18,7 +18,7 @@ import pytest
 
 from conftest import transports_built
 
-pytestmark = pytest.mark.needs_mcap  # every test here reads a bag
+pytestmark = pytest.mark.needs_rust  # every test here reads a bag
 
 MAGIC = b"\x89MCAP0\r\n"
 OP_CHANNEL, OP_MESSAGE, OP_CHUNK, OP_DATA_END = 0x04, 0x05, 0x06, 0x0F

@@ -13,7 +13,7 @@ import pytest
 
 from conftest import transports_built
 
-pytestmark = pytest.mark.needs_mcap  # every test here reads a bag
+pytestmark = pytest.mark.needs_rust  # every test here reads a bag
 
 PAIR = "int32 a\nfloat64 b\n"
 OUTER = "rvc_test_pkg/Pair inner\nbool ok\n"

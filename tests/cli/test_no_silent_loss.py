@@ -98,7 +98,7 @@ def bag_with_disorder(tmp_path, ts, rng, name):
     return str(next(folder.glob("*.mcap"))), 2 * n
 
 
-@pytest.mark.needs_mcap
+@pytest.mark.needs_rust
 @pytest.mark.parametrize("seed", SEEDS)
 def test_bags(rvc, tmp_path, typestore, seed):  # noqa: F811
     from test_mcap import GEAR_TOPIC, STEER_TOPIC

@@ -103,6 +103,7 @@ def test_on_violation_naming_the_input_file_is_refused_and_the_trace_kept(rvc, t
         assert trace.read_text() == text
 
 
+@pytest.mark.needs_rust  # a zenoh: input
 def test_on_violation_on_the_input_key_is_refused(rvc):
     if "zenoh" not in transports_built(rvc):
         pytest.fail("this rvc was built without Zenoh")

@@ -104,7 +104,7 @@ def late_bag(tmp_path, typestore):
     return str(next(folder.glob("*.mcap")))
 
 
-@pytest.mark.needs_mcap
+@pytest.mark.needs_rust
 def test_late_messages_of_a_bag_are_warned_counted_and_not_a_pass(rvc, tmp_path, typestore):
     from test_mcap import GEAR_TOPIC, STEER_TOPIC
     bag = late_bag(tmp_path, typestore)
