@@ -60,7 +60,20 @@ struct SyncCommand {
     if (!set_type_dir.empty()) {
       const std::filesystem::path dir = std::filesystem::path(set_type_dir) / t->package / "msg";
       std::filesystem::create_directories(dir);
-      std::ofstream(dir / (t->name + ".msg")) << text;
+      // Only a new file, or one an earlier rvc sync wrote (its first line), is
+      // written: a definition of the same name that rvc did not write is left as it is.
+      const std::filesystem::path file = dir / (t->name + ".msg");
+      if (std::filesystem::exists(file)) {
+        std::ifstream in(file);
+        std::string first;
+        std::getline(in, first);
+        if (first + "\n" != text.substr(0, text.find('\n') + 1))
+          throw std::invalid_argument("--set-type-dir: '" + file.string() +
+                                      "' exists and was not written by rvc sync: refusing to overwrite it");
+      }
+      std::ofstream out(file, std::ios::trunc);
+      out << text;
+      if (!out.flush()) throw std::runtime_error("--set-type-dir: cannot write '" + file.string() + "'");
     }
     std::fprintf(stderr, "rvc sync: sets are %s:\n%s", t->full_name().c_str(), text.c_str());
     return t;

@@ -138,3 +138,19 @@ def test_check_from_stdin_refuses_to_write_over_it(rvc, tmp_path):
     with open(other) as stdin:
         r = run([rvc, "check", "--spec", "{ok}", "-", "-o", str(trace)], stdin=stdin)
     assert r.returncode == 1, r.stderr
+
+
+# ---- rvc sync --set-type-dir writes only its own definitions ----
+
+def test_sync_set_type_dir_leaves_a_foreign_definition_alone(rvc, tmp_path):
+    if "dds" not in transports_built(rvc):
+        pytest.fail("this rvc was built without DDS")
+    mine = tmp_path / "defs" / "rvc_sync" / "msg" / "Set.msg"
+    mine.parent.mkdir(parents=True)
+    mine.write_text("int32 mine\n")  # a definition of the same name that rvc did not write
+    r = run([rvc, "sync", "--input", "a=dds:/rvc_guard_a", "--type", "std_msgs/msg/Bool",
+             "--input", "b=dds:/rvc_guard_b", "--type", "std_msgs/msg/Bool", "--set-type", "rvc_sync/msg/Set",
+             "--set-type-dir", str(tmp_path / "defs"), "--output", "dds:/rvc_guard_out", "--idle-timeout", "1"])
+    assert r.returncode == 2, r.stderr
+    assert "was not written by rvc sync: refusing to overwrite it" in r.stderr, r.stderr
+    assert mine.read_text() == "int32 mine\n"
