@@ -268,7 +268,7 @@ def run_dds(args, tmp):
         dp = DomainParticipant(domain)
         writer = DataWriter(dp, Topic(dp, "rt" + DDS_TOPICS["in"], String_), qos=dds_qos())
         deadline = time.time() + 20
-        while len(writer.get_matched_subscriptions()) < 2 and time.time() < deadline:  # rvc + receiver
+        while writer.get_publication_matched_status().current_count < 2 and time.time() < deadline:  # rvc + receiver
             time.sleep(0.01)
         time.sleep(0.3)
         log(f"[dds]   publishing {args.count} messages at {args.rate:g}/s (every {EVERY}th violating)")

@@ -89,3 +89,15 @@ def pytest_make_collect_report(collector):
     # a module-level pytest.importorskip skips the whole module at collection
     outcome = yield
     _fail_hidden_skip(outcome.get_result())
+
+
+def dds_matched(entity) -> int:
+    """How many peers a cyclonedds-Python DataWriter or DataReader has matched now.
+
+    Reads the PUBLICATION/SUBSCRIPTION_MATCHED status, one call. cyclonedds-Python's
+    get_matched_subscriptions() asks for the count, allocates, then asks again: a peer that
+    matches between the two calls makes it index past its array (IndexError, seen in CI).
+    """
+    if hasattr(entity, "get_publication_matched_status"):
+        return int(entity.get_publication_matched_status().current_count)
+    return int(entity.get_subscription_matched_status().current_count)

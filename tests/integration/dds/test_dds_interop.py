@@ -22,6 +22,7 @@ from cyclonedds.domain import DomainParticipant
 from cyclonedds.idl import IdlStruct
 from cyclonedds.idl.types import uint64
 from cyclonedds.pub import DataWriter
+from rvc_testlib import dds_matched
 from cyclonedds.qos import Policy, Qos
 from cyclonedds.sub import DataReader
 from cyclonedds.topic import Topic
@@ -106,7 +107,7 @@ def test_python_publisher_reaches_cpp_source(probe, domain, topic):
     try:
         dp = DomainParticipant(domain)
         writer = DataWriter(dp, Topic(dp, "rt" + topic, String_), qos=RVC_QOS)
-        wait_until(lambda: len(writer.get_matched_subscriptions()) >= 1, "probe reader never matched")
+        wait_until(lambda: dds_matched(writer) >= 1, "probe reader never matched")
         sent = payloads()
         for p in sent:
             writer.write(String_(data=p))
@@ -132,7 +133,7 @@ def test_eos_count_reveals_messages_the_source_never_saw(probe, domain, topic):
     try:
         dp = DomainParticipant(domain)
         writer = DataWriter(dp, Topic(dp, "rt" + topic, String_), qos=RVC_QOS)
-        wait_until(lambda: len(writer.get_matched_subscriptions()) >= 1, "probe reader never matched")
+        wait_until(lambda: dds_matched(writer) >= 1, "probe reader never matched")
         for i in range(7):
             writer.write(String_(data=json.dumps({"i": i})))
         writer.write(String_(data=f"{EOS_PREFIX} last=10 count=10"))
@@ -175,7 +176,7 @@ def test_rosbags_cdr_on_the_wire_reaches_cpp_source(probe, domain, topic):
     try:
         dp = DomainParticipant(domain)
         writer = DataWriter(dp, Topic(dp, "rt" + topic, String_), qos=RVC_QOS)
-        wait_until(lambda: len(writer.get_matched_subscriptions()) >= 1, "probe reader never matched")
+        wait_until(lambda: dds_matched(writer) >= 1, "probe reader never matched")
         for text in sent + [f"{EOS_PREFIX} last={len(sent)}"]:
             sample = String_(data="(replaced)")
             cdr = rosbags_cdr(text)
@@ -198,7 +199,7 @@ def test_frame_type_carries_publisher_seq(probe, domain, topic):
     try:
         dp = DomainParticipant(domain)
         writer = DataWriter(dp, Topic(dp, "rt" + topic, Frame_), qos=RVC_QOS)
-        wait_until(lambda: len(writer.get_matched_subscriptions()) >= 1, "probe reader never matched")
+        wait_until(lambda: dds_matched(writer) >= 1, "probe reader never matched")
         for seq in (1, 2, 4, 5, 5, 8):  # 3, 6, 7 missing; 5 repeated
             writer.write(Frame_(seq=seq, data=json.dumps({"seq": seq})))
         writer.write(Frame_(seq=9, data=f"{EOS_PREFIX} last=9 count=6"))
@@ -223,7 +224,7 @@ def test_ros2_graph_sees_rt_topic_and_string_type(probe, domain, topic):
     )
     try:
         # The probe waits for stdin, so its writer is alive while we look.
-        wait_until(lambda: reader.get_matched_publications(), "probe publication never matched")
+        wait_until(lambda: dds_matched(reader), "probe publication never matched")
         pub = reader.get_matched_publication_data(reader.get_matched_publications()[0])
         out, err = proc.communicate("{}\n", timeout=HANG_GUARD_S + 30)
     finally:
@@ -283,7 +284,7 @@ def test_participants_only_use_loopback(probe, domain, topic):
     try:
         dp = DomainParticipant(domain)
         writer = DataWriter(dp, Topic(dp, "rt" + topic, String_), qos=RVC_QOS)
-        wait_until(lambda: len(writer.get_matched_subscriptions()) >= 1, "probe reader never matched")
+        wait_until(lambda: dds_matched(writer) >= 1, "probe reader never matched")
         writer.write(String_(data="{}"))
         _assert_loopback_only(proc.pid)
         _assert_loopback_only(os.getpid())

@@ -20,6 +20,7 @@ import time
 import pytest
 
 from conftest import transports_built
+from rvc_testlib import dds_matched
 
 HANG_GUARD = 60
 
@@ -250,7 +251,7 @@ def test_python_dds_publisher_is_monitored_and_verdicts_reach_python(rvc, tmp_pa
         dp = DomainParticipant(domain)
         reader = DataReader(dp, Topic(dp, "rt/rvc_py/verdicts", String_), qos=dds_qos())
         writer = DataWriter(dp, Topic(dp, "rt/rvc_py/in", String_), qos=dds_qos())
-        wait_for(lambda: writer.get_matched_subscriptions() and reader.get_matched_publications(),
+        wait_for(lambda: dds_matched(writer) and dds_matched(reader),
                  "rvc monitor to match both topics")
         for l in lines:
             writer.write(String_(data=l))

@@ -20,6 +20,7 @@ import time
 import pytest
 
 from conftest import transports_built
+from rvc_testlib import dds_matched
 from test_python_peers import HANG_GUARD, dds_qos, wait_for
 
 MSGS = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "dds", "msgs")
@@ -187,7 +188,7 @@ def test_python_typed_publisher_is_echoed_and_monitored(rvc, tmp_path, types):
     try:
         dp = DomainParticipant(domain)
         writer = DataWriter(dp, Topic(dp, "rt/rvc_typed/mixed", types["Mixed"]), qos=xcdr1_qos())
-        wait_for(lambda: len(writer.get_matched_subscriptions()) >= 2, "rvc echo and rvc monitor to match")
+        wait_for(lambda: dds_matched(writer) >= 2, "rvc echo and rvc monitor to match")
         for v in values:
             writer.write(to_idl(types, v))
         out, err = echo.communicate(timeout=HANG_GUARD)
