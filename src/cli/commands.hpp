@@ -26,6 +26,7 @@ Runner register_perf(CLI::App& app);
 Runner register_bridge(CLI::App& app);
 Runner register_msg(CLI::App& app);         // ROS 2 message types, CDR <-> JSON
 Runner register_echo(CLI::App& app);        // print an endpoint's messages as JSON lines
+Runner register_hz(CLI::App& app);          // rate/jitter/silence/latency health check, /diagnostics
 Runner register_sync(CLI::App& app);        // several topics -> one stream of sets
 Runner register_dashboard(CLI::App& app);   // web page over a results database
 

@@ -1,0 +1,550 @@
+// rvc hz: a ready-made health check of N topics, what one reaches for instead
+// of `ros2 topic hz` plus Autoware's topic_state_monitor. Per topic, over the
+// last window_size arrivals: rate, inter-arrival jitter (std dev, min, max),
+// silence since the last message and stamp latency (arrival - stamp); the
+// topic_state_monitor state (runtime/topic_rate.hpp) from warn_rate,
+// error_rate, timeout, window_size (cli/hz_config.hpp: flags and/or YAML).
+//
+// Output: a table every --period (--json: one object per topic per period),
+// and with --diagnostics a diagnostic_msgs/DiagnosticArray (one status per
+// topic) every period and at once whenever a topic's state changes. A topic
+// that goes silent turns Timeout on a timer: the loop sleeps until the
+// earliest timeout deadline, not until the next message.
+//
+// Time: arrivals are taken on the transport thread (steady clock for rate,
+// jitter and silence; system clock for latency against ROS stamps). With
+// --time-source stamps the messages' own time field is the clock instead
+// (offline files, deterministic tests): reports fall on period boundaries of
+// that time and "now" is the latest time read.
+#include <algorithm>
+#include <charconv>
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <cstdio>
+#include <limits>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "cli/commands.hpp"
+#include "cli/hz_config.hpp"
+#include "cli/signals.hpp"
+#include "cli/transport_flags.hpp"
+#include "cli/type_options.hpp"
+#include "io/cdr_decoder.hpp"
+#include "io/diagnostics.hpp"
+#include "io/json_writer.hpp"
+#include "msg/type_registry.hpp"
+#include "runtime/time_field_reader.hpp"
+#include "runtime/topic_rate.hpp"
+#include "transport/transport_options.hpp"
+
+namespace rvc::cli {
+namespace {
+
+using SteadyClock = std::chrono::steady_clock;
+
+double wall_seconds() {
+  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
+
+// One message as it arrived, with both clocks read on the transport thread:
+// a batch waiting in the queue must not look like a burst.
+struct Arrival {
+  uint32_t input = 0;
+  bool eos = false;
+  SteadyClock::time_point steady;
+  double wall = 0;
+  std::string payload;
+};
+
+// Transport threads -> the hz loop. Bounded: a full queue blocks the
+// producer (backpressure, as transport::FrameQueue), nothing is dropped.
+class ArrivalQueue {
+ public:
+  explicit ArrivalQueue(size_t capacity) : capacity_(capacity) {}
+  void push(uint32_t input, const transport::Frame& f) {
+    Arrival a{input, f.eos, SteadyClock::now(), wall_seconds(), std::string(f.payload)};
+    std::unique_lock<std::mutex> lock(mutex_);
+    not_full_.wait(lock, [&] { return items_.size() < capacity_ || closed_; });
+    if (closed_) return;
+    items_.push_back(std::move(a));
+    if (items_.size() == 1) not_empty_.notify_one();
+  }
+  // Waits until something arrived or `until`, then takes everything queued.
+  void pop_until(SteadyClock::time_point until, std::vector<Arrival>& out) {
+    out.clear();
+    std::unique_lock<std::mutex> lock(mutex_);
+    not_empty_.wait_until(lock, until, [&] { return !items_.empty() || closed_; });
+    out.swap(items_);
+    not_full_.notify_all();
+  }
+  void close() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    closed_ = true;
+    not_full_.notify_all();
+    not_empty_.notify_all();
+  }
+
+ private:
+  std::mutex mutex_;
+  std::condition_variable not_full_, not_empty_;
+  std::vector<Arrival> items_;
+  size_t capacity_;
+  bool closed_ = false;
+};
+
+std::string number_text(double v) {
+  if (!std::isfinite(v)) return v > 0 ? "inf" : "nan";
+  char buf[64];
+  auto [p, ec] = std::to_chars(buf, buf + sizeof buf, v);
+  return std::string(buf, p);
+}
+
+struct HzTopic {
+  HzTopicConfig config;
+  const msg::MessageType* type = nullptr;
+  std::unique_ptr<runtime::TimeFieldReader> arrival_field;  // --time-source stamps
+  std::unique_ptr<runtime::TimeFieldReader> stamp_field;    // latency; null: none
+  bool stamp_required = false;  // named explicitly: a message without it is rejected
+  runtime::TopicRate stats;
+  std::unique_ptr<transport::Source> source;
+  uint64_t rejected = 0;
+  bool ended = false;  // end-of-stream marker (files, rvc publishers)
+  runtime::TopicState reported = runtime::TopicState::NotReceived;  // state last published
+
+  explicit HzTopic(HzTopicConfig c) : config(std::move(c)), stats(config.thresholds) {}
+  uint64_t received() const { return stats.received() + rejected; }
+};
+
+struct HzCommand {
+  transport::TransportOptions transports;
+  std::vector<std::string> inputs;
+  std::string config_path;
+  TypeOptions typed;
+  std::string stamp_field;  // --stamp-field: for every topic without its own
+  std::string time_source = "receive";
+  std::string time_field = "time";
+  HzFlagOverrides flags;
+  double period = 1.0;
+  bool json = false;
+  std::vector<std::string> diagnostics;
+  uint64_t count = 0;
+  double duration = 0, idle_timeout = 0;
+
+  std::vector<std::unique_ptr<HzTopic>> topics;
+  std::vector<std::unique_ptr<transport::Sink>> diag_sinks;
+  std::vector<bool> diag_is_file;  // files get the JSON form (a line), networks CDR
+  bool stamps_mode() const { return time_source == "stamps"; }
+  bool header_printed = false;
+  uint64_t diag_published = 0;
+
+  // The topics with their types and stamp readers; false after printing why.
+  bool prepare() {
+    if (!typed.type.empty() || !typed.msg_paths.empty())
+      for (const auto& p : typed.msg_paths) typed.registry.add_search_path(p);
+    for (auto& config : hz_topics(config_path, inputs, flags)) {
+      auto t = std::make_unique<HzTopic>(config);
+      const std::string type_name = config.type.empty() ? typed.type : config.type;
+      if (!type_name.empty()) {
+        if (!TypeOptions::typed_scheme(config.uri)) {
+          std::fprintf(stderr, "rvc: %s: a type (%s) applies to dds: and zenoh: topics; files hold JSON lines\n",
+                       config.uri.c_str(), type_name.c_str());
+          return false;
+        }
+        t->type = &typed.registry.resolve(type_name);
+      }
+      const std::string stamp = config.stamp_field.empty() ? stamp_field : config.stamp_field;
+      if (stamps_mode()) {
+        const std::string arrival =
+            t->type ? io::CdrDecoder::default_time_field(*t->type, time_field) : time_field;
+        t->arrival_field = field_reader(*t, arrival, "--time-field");
+        if (!t->arrival_field) return false;
+      }
+      if (stamp == "none") {
+        // no latency
+      } else if (!stamp.empty()) {
+        t->stamp_field = field_reader(*t, stamp, "stamp field");
+        if (!t->stamp_field) return false;
+        t->stamp_required = true;
+      } else if (!stamps_mode()) {
+        // Automatic: a typed topic's header.stamp (or stamp) if its type has
+        // one; JSON's "time" where a message carries it.
+        if (t->type) {
+          const std::string guess = io::CdrDecoder::default_time_field(*t->type, "time");
+          try {
+            t->stamp_field = std::make_unique<runtime::TimeFieldReader>(guess, t->type);
+          } catch (const msg::MsgError&) {  // no stamp in this type: no latency
+          }
+        } else {
+          t->stamp_field = std::make_unique<runtime::TimeFieldReader>("time", nullptr);
+        }
+      }
+      topics.push_back(std::move(t));
+    }
+    return true;
+  }
+
+  std::unique_ptr<runtime::TimeFieldReader> field_reader(const HzTopic& t, const std::string& field, const char* what) {
+    try {
+      return std::make_unique<runtime::TimeFieldReader>(field, t.type);
+    } catch (const msg::MsgError& e) {
+      std::fprintf(stderr, "rvc: %s: %s '%s': %s\n", t.config.uri.c_str(), what, field.c_str(), e.what());
+      return nullptr;
+    }
+  }
+
+  bool open_diagnostics() {
+    transport::TransportOptions diag_transports = transports;
+#ifdef RVC_HAVE_DDS
+    diag_transports.dds.ros_type = &typed.registry.resolve(std::string(io::kDiagnosticArrayType));
+    diag_transports.dds.qos = "reliable";
+#endif
+    for (const auto& uri : diagnostics) {
+      for (const auto& t : topics)
+        if (transport::reads_back(t->config.uri, uri)) {
+          std::fprintf(stderr, "rvc: --diagnostics %s would be read back by the input %s\n", uri.c_str(),
+                       t->config.uri.c_str());
+          return false;
+        }
+      diag_sinks.push_back(transport::open_sink(uri, diag_transports));
+      diag_is_file.push_back(transport::scheme_of(uri) == "file");
+    }
+    return true;
+  }
+
+  // One arrival into its topic's statistics; false if the message is refused.
+  bool accept(HzTopic& t, const Arrival& a, double arrival) {
+    std::string error;
+    std::optional<double> latency;
+    double stamp = 0;
+    if (t.stamp_field) {
+      switch (t.stamp_field->read(a.payload, stamp, error)) {
+        case runtime::TimeFieldReader::Result::Ok:
+          latency = (stamps_mode() ? arrival : a.wall) - stamp;
+          break;
+        case runtime::TimeFieldReader::Result::Missing:
+          if (t.stamp_required) return refuse(t, error);
+          break;
+        case runtime::TimeFieldReader::Result::Malformed: return refuse(t, error);
+      }
+    }
+    t.stats.add(arrival, latency);
+    return true;
+  }
+
+  bool refuse(HzTopic& t, const std::string& why) {
+    if (++t.rejected <= 20)
+      std::fprintf(stderr, "rvc hz: %s: message %llu refused: %s\n", t.config.uri.c_str(),
+                   static_cast<unsigned long long>(t.received()), why.c_str());
+    return false;
+  }
+
+  // --- reports ---------------------------------------------------------------
+
+  void print_table(double now, bool final) {
+    if (!header_printed || final) {
+      std::printf("%-28s %10s %9s %9s %9s %6s %9s %9s %9s %9s %s\n", final ? "FINAL topic" : "topic", "rate_hz",
+                  "min_s", "max_s", "std_s", "window", "silence_s", "lat_mean", "lat_max", "received", "state");
+      header_printed = true;
+    }
+    for (const auto& t : topics) {
+      const runtime::RateSummary s = t->stats.summary(now);
+      auto col = [](double v, bool have) { return have ? number_fixed(v) : std::string("-"); };
+      const bool intervals = s.window >= 2;
+      std::printf("%-28s %10s %9s %9s %9s %6zu %9s %9s %9s %9llu %s\n", t->config.uri.c_str(),
+                  intervals ? number_fixed(s.rate, 3).c_str() : "-", col(s.interval_min, intervals).c_str(),
+                  col(s.interval_max, intervals).c_str(), col(s.interval_std, intervals).c_str(), s.window,
+                  col(s.silence, t->stats.any()).c_str(), col(s.latency_mean, s.latency_samples > 0).c_str(),
+                  col(s.latency_max, s.latency_samples > 0).c_str(), static_cast<unsigned long long>(t->received()),
+                  runtime::to_string(t->stats.state(now)));
+    }
+    std::fflush(stdout);
+  }
+
+  static std::string number_fixed(double v, int decimals = 5) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
+    return buf;
+  }
+
+  void print_json(double now, bool final) {
+    for (const auto& t : topics) {
+      const runtime::RateSummary s = t->stats.summary(now);
+      const runtime::TopicState state = t->stats.state(now);
+      io::JsonObject o;
+      o.add("t", now).add("topic", t->config.uri).add("state", runtime::to_string(state))
+          .add("level", io::to_string(runtime::diag_level(state)))
+          .add("received", t->received()).add("checked", s.received).add("rejected", t->rejected)
+          .add("window", static_cast<uint64_t>(s.window));
+      const bool intervals = s.window >= 2;
+      // null where there is nothing to compute from (JsonObject writes inf as null)
+      const double none = std::numeric_limits<double>::infinity();
+      o.add("rate_hz", intervals ? s.rate : none)
+          .add("interval_mean_s", intervals ? s.interval_mean : none)
+          .add("interval_std_s", intervals ? s.interval_std : none)
+          .add("interval_min_s", intervals ? s.interval_min : none)
+          .add("interval_max_s", intervals ? s.interval_max : none)
+          .add("silence_s", t->stats.any() ? s.silence : none)
+          .add("latency_samples", static_cast<uint64_t>(s.latency_samples))
+          .add("latency_mean_s", s.latency_samples ? s.latency_mean : none)
+          .add("latency_max_s", s.latency_samples ? s.latency_max : none)
+          .add("final", final);
+      std::printf("%s\n", o.str().c_str());
+    }
+    std::fflush(stdout);
+  }
+
+  void report(double now, bool final) {
+    if (json) print_json(now, final);
+    else print_table(now, final);
+  }
+
+  std::vector<io::DiagStatus> statuses(double now) {
+    std::vector<io::DiagStatus> out;
+    for (const auto& t : topics) {
+      const runtime::RateSummary s = t->stats.summary(now);
+      const runtime::TopicState state = t->stats.state(now);
+      const auto& th = t->config.thresholds;
+      io::DiagStatus d;
+      d.level = runtime::diag_level(state);
+      d.name = "rvc hz: " + t->config.uri;
+      d.hardware_id = "rvc";
+      d.message = runtime::to_string(state);
+      if (state == runtime::TopicState::Timeout) d.message += ": no message for " + number_fixed(s.silence, 3) + " s";
+      if (state == runtime::TopicState::WarnRate || state == runtime::TopicState::ErrorRate)
+        d.message += ": " + number_fixed(s.rate, 3) + " Hz";
+      auto add = [&](const char* key, std::string value) { d.values.emplace_back(key, std::move(value)); };
+      const bool intervals = s.window >= 2;
+      add("topic", t->config.uri);
+      add("status", runtime::to_string(state));
+      add("rate_hz", intervals ? number_text(s.rate) : "");
+      add("warn_rate", number_text(th.warn_rate));
+      add("error_rate", number_text(th.error_rate));
+      add("timeout", number_text(th.timeout));
+      add("window_size", std::to_string(th.window_size));
+      add("window", std::to_string(s.window));
+      add("interval_min_s", intervals ? number_text(s.interval_min) : "");
+      add("interval_max_s", intervals ? number_text(s.interval_max) : "");
+      add("interval_std_s", intervals ? number_text(s.interval_std) : "");
+      add("silence_s", t->stats.any() ? number_text(s.silence) : "");
+      add("latency_mean_s", s.latency_samples ? number_text(s.latency_mean) : "");
+      add("latency_max_s", s.latency_samples ? number_text(s.latency_max) : "");
+      add("received", std::to_string(t->received()));
+      add("rejected", std::to_string(t->rejected));
+      out.push_back(std::move(d));
+      t->reported = state;
+    }
+    return out;
+  }
+
+  // `stamp`: the header's time (seconds since the epoch, or the stamps' clock).
+  void publish(double now, double stamp) {
+    if (diag_sinks.empty()) {
+      for (auto& t : topics) t->reported = t->stats.state(now);
+      return;
+    }
+    const auto list = statuses(now);
+    std::string cdr, json_line;
+    for (size_t i = 0; i < diag_sinks.size(); ++i) {
+      if (diag_is_file[i]) {
+        if (json_line.empty()) json_line = io::diagnostic_array_json(stamp, list);
+        diag_sinks[i]->put(json_line, diag_published + 1);
+      } else {
+        if (cdr.empty()) cdr = io::diagnostic_array_cdr(stamp, list);
+        diag_sinks[i]->put(cdr, diag_published + 1);
+      }
+      diag_sinks[i]->flush();
+    }
+    ++diag_published;
+  }
+
+  bool state_changed(double now) const {
+    return std::any_of(topics.begin(), topics.end(),
+                       [&](const auto& t) { return t->stats.state(now) != t->reported; });
+  }
+
+  // --- the loop --------------------------------------------------------------
+
+  int run() {
+    if (time_source != "receive" && time_source != "stamps") {
+      std::fprintf(stderr, "rvc: --time-source must be receive or stamps, not '%s'\n", time_source.c_str());
+      return kUsage;
+    }
+    if (!prepare() || !open_diagnostics()) return kUsage;
+    for (auto& t : topics) {
+      transport::TransportOptions per_input = transports;
+#ifdef RVC_HAVE_DDS
+      per_input.dds.ros_type = t->type;
+#endif
+      t->source = transport::open_source(t->config.uri, per_input);
+    }
+    install_stop_signals();
+    ArrivalQueue queue(4096);
+    for (uint32_t i = 0; i < topics.size(); ++i)
+      topics[i]->source->start([&queue, i](const transport::Frame& f) { queue.push(i, f); });
+
+    const auto start = SteadyClock::now();
+    auto since_start = [&](SteadyClock::time_point p) { return std::chrono::duration<double>(p - start).count(); };
+    auto to_point = [&](double s) {
+      return start + std::chrono::duration_cast<SteadyClock::duration>(std::chrono::duration<double>(s));
+    };
+    const double kNever = std::numeric_limits<double>::infinity();
+    double next_report = stamps_mode() ? kNever : period;  // stamps: set by the first message
+    double stamp_now = -kNever;                             // stamps: the latest time read
+    double last_message = 0;                                // steady s, for --idle-timeout
+    uint64_t total = 0;
+    std::vector<Arrival> batch;
+    bool finished = false;
+    if (!stamps_mode()) publish(0, wall_seconds());  // every topic NotReceived: a monitor sees rvc hz is up
+
+    while (!finished && !stop_requested()) {
+      // Sleep until the earliest thing that can happen without a message: a
+      // report, a topic's timeout (strictly after its deadline, hence the
+      // millisecond), the end of --duration or --idle-timeout; at most 100
+      // ms, to notice a stop signal.
+      double wake = since_start(SteadyClock::now()) + 0.1;
+      if (!stamps_mode()) {
+        wake = std::min(wake, next_report);
+        for (const auto& t : topics)
+          if (auto at = t->stats.timeout_at(); at && t->reported != runtime::TopicState::Timeout)
+            wake = std::min(wake, *at + 0.001);
+      }
+      if (duration > 0) wake = std::min(wake, duration);
+      if (idle_timeout > 0) wake = std::min(wake, last_message + idle_timeout);
+      queue.pop_until(to_point(wake), batch);
+
+      for (const Arrival& a : batch) {
+        HzTopic& t = *topics[a.input];
+        if (a.eos) {
+          t.ended = true;
+          continue;
+        }
+        last_message = since_start(a.steady);
+        double arrival = last_message;
+        if (stamps_mode()) {
+          std::string error;
+          double time = 0;
+          const auto r = t.arrival_field->read(a.payload, time, error);
+          if (r != runtime::TimeFieldReader::Result::Ok) {
+            refuse(t, error);
+            ++total;
+            continue;
+          }
+          if (t.stats.any() && time < t.stats.last_arrival()) {
+            refuse(t, "time " + number_text(time) + " is before the previous message's " +
+                          number_text(t.stats.last_arrival()) + " (--time-source stamps needs them in order)");
+            ++total;
+            continue;
+          }
+          // Reports due before this message see the topics as they were then.
+          if (next_report == kNever) next_report = time + period;
+          while (time >= next_report) {
+            stamp_now = std::max(stamp_now, next_report);
+            report(next_report, false);
+            publish(next_report, next_report);
+            next_report += period;
+          }
+          stamp_now = std::max(stamp_now, time);
+          arrival = time;
+        }
+        accept(t, a, arrival);
+        ++total;
+        if (count > 0 && total >= count) {
+          finished = true;
+          break;
+        }
+      }
+
+      const double now_steady = since_start(SteadyClock::now());
+      const double now = stamps_mode() ? stamp_now : now_steady;
+      if (!stamps_mode() && now_steady >= next_report) {
+        report(now, false);
+        publish(now, wall_seconds());
+        next_report += period * std::max(1.0, std::floor((now_steady - next_report) / period) + 1);
+      } else if (state_changed(now) && (!stamps_mode() || stamp_now > -kNever)) {
+        publish(now, stamps_mode() ? stamp_now : wall_seconds());  // Timeout as it happens, not at the next report
+      }
+      if (std::all_of(topics.begin(), topics.end(), [](const auto& t) { return t->ended; })) finished = true;
+      if (duration > 0 && now_steady >= duration) finished = true;
+      if (idle_timeout > 0 && now_steady - last_message >= idle_timeout) finished = true;
+    }
+    for (auto& t : topics) t->source->stop();
+    queue.close();
+
+    const double now = stamps_mode() ? (stamp_now > -kNever ? stamp_now : 0) : since_start(SteadyClock::now());
+    report(now, true);
+    if (stamps_mode() ? stamp_now > -kNever : true) publish(now, stamps_mode() ? now : wall_seconds());
+    return finish(now, total);
+  }
+
+  // The final line per topic (received = checked + rejected) and the exit status.
+  int finish(double now, uint64_t total) {
+    runtime::Outcome outcome;
+    for (const auto& t : topics) {
+      const runtime::TopicState state = t->stats.state(now);
+      std::fprintf(stderr, "rvc hz: %s: received %llu (checked %llu, rejected %llu), final state %s\n",
+                   t->config.uri.c_str(), static_cast<unsigned long long>(t->received()),
+                   static_cast<unsigned long long>(t->stats.received()),
+                   static_cast<unsigned long long>(t->rejected), runtime::to_string(state));
+      if (runtime::diag_level(state) == io::DiagLevel::Error) outcome.violated = true;
+      if (t->rejected > 0) outcome.rejected = true;
+      if (t->received() == 0) {
+        const std::string why = t->source->diagnosis();
+        if (!why.empty()) std::fprintf(stderr, "rvc hz: %s: %s\n", t->config.uri.c_str(), why.c_str());
+      }
+    }
+    if (total == 0) {
+      std::fprintf(stderr, "rvc hz: nothing was received\n");
+      return kIncomplete;
+    }
+    return outcome.exit_code();
+  }
+};
+
+}  // namespace
+
+Runner register_hz(CLI::App& app) {
+  auto cmd = std::make_shared<HzCommand>();
+  CLI::App* sub = app.add_subcommand(
+      "hz", "Watch topics' rate, jitter, silence and stamp latency; topic_state_monitor states, /diagnostics");
+  sub->add_option("inputs", cmd->inputs, "Endpoints: dds:TOPIC, zenoh:KEYEXPR, file:PATH (several: one row each)");
+  sub->add_option("--config", cmd->config_path,
+                  "YAML file: topics with warn_rate, error_rate, timeout, window_size, type, stamp_field (docs/cli.md)")
+      ->check(CLI::ExistingFile);
+  cmd->typed.add_to(*sub, "Message type of the dds:/zenoh: samples: ROS 2 pkg/msg/Name (else JSON payloads)");
+  sub->add_option("--warn-rate", cmd->flags.warn_rate, "WarnRate below this rate, Hz (default 0: off)")
+      ->check(CLI::NonNegativeNumber);
+  sub->add_option("--error-rate", cmd->flags.error_rate, "ErrorRate below this rate, Hz (default 0: off)")
+      ->check(CLI::NonNegativeNumber);
+  sub->add_option("--timeout", cmd->flags.timeout, "Timeout after this many seconds without a message (default 1; 0: off)")
+      ->check(CLI::NonNegativeNumber);
+  sub->add_option("--window", cmd->flags.window_size, "Arrivals the rate and jitter are computed over (default 10)")
+      ->check(CLI::Range(size_t{2}, size_t{10000000}));
+  sub->add_option("--stamp-field", cmd->stamp_field,
+                  "Latency = arrival - this field (a number of seconds or a Time); none: no latency (default: "
+                  "header.stamp or stamp of a typed message, \"time\" of JSON where present)");
+  sub->add_option("--time-source", cmd->time_source,
+                  "receive: arrival on this host's clock (default); stamps: the messages' --time-field is the clock")
+      ->check(CLI::IsMember({"receive", "stamps"}));
+  sub->add_option("--time-field", cmd->time_field, "With --time-source stamps: the field read as arrival time (default time)");
+  sub->add_option("--period", cmd->period, "Seconds between reports and /diagnostics (default 1)")
+      ->check(CLI::Range(0.01, 3600.0));
+  sub->add_flag("--json", cmd->json, "One JSON object per topic per period instead of the table");
+  sub->add_option("--diagnostics", cmd->diagnostics,
+                  "Publish diagnostic_msgs/DiagnosticArray here, e.g. dds:/diagnostics, zenoh:diagnostics "
+                  "(CDR), file:PATH (JSON lines); repeatable");
+  sub->add_option("--count,-n", cmd->count, "Stop after this many messages in all");
+  sub->add_option("--duration", cmd->duration, "Stop after this many seconds")->check(CLI::NonNegativeNumber);
+  sub->add_option("--idle-timeout", cmd->idle_timeout, "Stop after this many seconds without any message")
+      ->check(CLI::NonNegativeNumber);
+  sub->footer("Exit status: 0 every topic ended OK or WarnRate, 1 some topic ended NotReceived, ErrorRate or Timeout, "
+              "3 messages were refused, 6 nothing arrived at all.");
+  add_transport_options(*sub, cmd->transports);
+  return [cmd] { return cmd->run(); };
+}
+
+}  // namespace rvc::cli
