@@ -1,0 +1,212 @@
+"""rvc hz on files with --time-source stamps: the statistics run on the messages' own times, so
+Python recomputes them exactly from the same stamps (the oracle: statistics.pstdev, min, max, the
+rate as topic_state_monitor defines it: (n - 1) / (last - first) over the last window_size arrivals)
+and the topic_state_monitor states from the same thresholds. Also the YAML configuration, the
+DiagnosticArray written as JSON lines, bad files and options, and counts that add up."""
+import json
+import random
+import statistics
+import subprocess
+
+import pytest
+
+WINDOW = 7
+
+
+def write_topic(path, n, start, period, seed, stamp=True):
+    rnd = random.Random(seed)
+    rows, t = [], start
+    for _ in range(n):
+        t += period + rnd.uniform(-period / 10, period / 10)
+        row = {"time": t}
+        if stamp:
+            row["stamp"] = t - rnd.uniform(0.001, 0.05)
+        rows.append(row)
+    path.write_text("".join(json.dumps(r) + "\n" for r in rows))
+    return rows
+
+
+def expected(rows, now, window=WINDOW, warn=0.0, error=0.0, timeout=1.0):
+    """What rvc hz must report for these arrivals at time `now` (all of rows arrived by then)."""
+    win = rows[-window:]
+    times = [r["time"] for r in win]
+    iv = [b - a for a, b in zip(times, times[1:])]
+    rate = (len(times) - 1) / (times[-1] - times[0])
+    lat = [r["time"] - r["stamp"] for r in win if "stamp" in r]
+    if now - times[-1] > timeout > 0:
+        state = "Timeout"
+    elif error > 0 and rate < error:
+        state = "ErrorRate"
+    elif warn > 0 and rate < warn:
+        state = "WarnRate"
+    else:
+        state = "OK"
+    return {"rate_hz": rate, "interval_mean_s": statistics.fmean(iv), "interval_std_s": statistics.pstdev(iv),
+            "interval_min_s": min(iv), "interval_max_s": max(iv), "silence_s": now - times[-1],
+            "latency_mean_s": statistics.fmean(lat) if lat else None, "latency_max_s": max(lat) if lat else None,
+            "window": len(win), "state": state}
+
+
+def compare(got, want):
+    for key, value in want.items():
+        if isinstance(value, float):
+            assert got[key] == pytest.approx(value, rel=1e-9, abs=1e-12), key
+        else:
+            assert got[key] == value, key
+
+
+def run(rvc, *args, timeout=60):
+    return subprocess.run([rvc, "hz", *args], capture_output=True, text=True, timeout=timeout)
+
+
+def test_periodic_reports_match_python_on_the_same_stamps(rvc, tmp_path):
+    rows = write_topic(tmp_path / "a.jsonl", 120, 1000.0, 0.1, seed=1)
+    r = run(rvc, f"file:{tmp_path / 'a.jsonl'}", "--time-source", "stamps", "--stamp-field", "stamp", "--json",
+            "--period", "1", "--window", str(WINDOW), "--warn-rate", "9.9", "--error-rate", "5")
+    assert r.returncode == 0, r.stderr
+    reports = [json.loads(line) for line in r.stdout.splitlines()]
+    periodic, final = reports[:-1], reports[-1]
+    # A report falls on each period boundary of the stamps, before the first message at or past it.
+    first = rows[0]["time"]
+    boundaries = []
+    b = first + 1
+    while b <= rows[-1]["time"]:
+        boundaries.append(b)
+        b += 1
+    assert [p["t"] for p in periodic] == pytest.approx(boundaries, rel=0, abs=1e-9)
+    assert len(periodic) >= 10
+    states = set()
+    for p in periodic:
+        seen = [row for row in rows if row["time"] < p["t"]]
+        want = expected(seen, p["t"], warn=9.9, error=5)
+        compare(p, want)
+        assert p["received"] == p["checked"] == len(seen) and p["rejected"] == 0
+        states.add(p["state"])
+    assert final["final"] is True and final["received"] == 120
+    compare(final, expected(rows, rows[-1]["time"], warn=9.9, error=5))
+    assert states == {"OK", "WarnRate"}  # the thresholds sit inside the jitter: both states occur
+    assert "received 120 (checked 120, rejected 0), final state" in r.stderr
+
+
+def test_a_topic_that_stopped_times_out_and_fails_the_run(rvc, tmp_path):
+    a = write_topic(tmp_path / "a.jsonl", 60, 0.0, 0.1, seed=2)  # until ~6 s
+    b = write_topic(tmp_path / "b.jsonl", 20, 0.0, 0.1, seed=3)  # stops at ~2 s
+    diag = tmp_path / "diag.jsonl"
+    r = run(rvc, f"file:{tmp_path / 'a.jsonl'}", f"file:{tmp_path / 'b.jsonl'}", "--time-source", "stamps",
+            "--stamp-field", "stamp", "--json", "--window", str(WINDOW), "--timeout", "0.5",
+            "--diagnostics", f"file:{diag}")
+    assert r.returncode == 1, r.stderr  # a topic ended in an ERROR state
+    final = {o["topic"]: o for o in map(json.loads, r.stdout.splitlines()) if o["final"]}
+    now = a[-1]["time"]
+    compare(final[f"file:{tmp_path / 'a.jsonl'}"], expected(a, now, timeout=0.5))
+    compare(final[f"file:{tmp_path / 'b.jsonl'}"], expected(b, now, timeout=0.5))
+    assert final[f"file:{tmp_path / 'b.jsonl'}"]["state"] == "Timeout"
+    assert final[f"file:{tmp_path / 'b.jsonl'}"]["level"] == "ERROR"
+    # The last DiagnosticArray: one status per topic, levels as topic_state_monitor's.
+    arrays = [json.loads(line) for line in diag.read_text().splitlines()]
+    last = arrays[-1]
+    by_name = {s["name"]: s for s in last["status"]}
+    sb = by_name[f"rvc hz: file:{tmp_path / 'b.jsonl'}"]
+    sa = by_name[f"rvc hz: file:{tmp_path / 'a.jsonl'}"]
+    assert (sa["level"], sb["level"]) == (0, 2)
+    values = {v["key"]: v["value"] for v in sb["values"]}
+    assert values["status"] == "Timeout" and values["received"] == "20" and values["window_size"] == str(WINDOW)
+    assert float(values["rate_hz"]) == pytest.approx(expected(b, now)["rate_hz"], rel=1e-12)
+    assert last["header"]["stamp"]["sec"] == int(now)
+    # Before b's first message it was NotReceived (ERROR too); it turned Timeout once a's stamps passed
+    # its deadline, published then. (Two files are read side by side: when exactly depends on the
+    # reading order; the final report does not.)
+    deadline = b[-1]["time"] + 0.5
+    timeouts = [x for x in arrays if any(s["name"] == sb["name"] and s["message"].startswith("Timeout")
+                                         for s in x["status"])]
+    assert timeouts
+    stamp = timeouts[0]["header"]["stamp"]
+    assert stamp["sec"] + stamp["nanosec"] * 1e-9 > deadline - 1e-6
+
+
+def test_yaml_thresholds_per_topic_and_defaults(rvc, tmp_path):
+    rows = write_topic(tmp_path / "a.jsonl", 40, 0.0, 0.1, seed=4)
+    write_topic(tmp_path / "b.jsonl", 40, 0.0, 0.1, seed=5)
+    cfg = tmp_path / "hz.yaml"
+    cfg.write_text(f"warn_rate: 20\nwindow_size: 5\ntopics:\n"
+                   f"  - topic: file:{tmp_path / 'a.jsonl'}\n"
+                   f"  - topic: file:{tmp_path / 'b.jsonl'}\n    warn_rate: 2\n    window_size: 4\n")
+    r = run(rvc, "--config", str(cfg), "--time-source", "stamps", "--json", "--timeout", "0")
+    assert r.returncode == 0, r.stderr  # WarnRate is a WARN: not a failed run
+    final = {o["topic"]: o for o in map(json.loads, r.stdout.splitlines()) if o["final"]}
+    a = final[f"file:{tmp_path / 'a.jsonl'}"]
+    b = final[f"file:{tmp_path / 'b.jsonl'}"]
+    assert (a["state"], a["window"]) == ("WarnRate", 5)
+    assert (b["state"], b["window"]) == ("OK", 4)
+    assert a["rate_hz"] == pytest.approx(4 / (rows[-1]["time"] - rows[-5]["time"]), rel=1e-12)
+    # JSON time without --stamp-field is the arrival here: no latency asked for.
+    assert a["latency_samples"] == 0 and a["latency_mean_s"] is None
+
+
+def test_counts_add_up_with_refused_messages(rvc, tmp_path):
+    f = tmp_path / "a.jsonl"
+    f.write_text('{"time": 1.0}\n{"x": 1}\nnot json\n{"time": 0.5}\n{"time": 1.5}\n{"time": "2"}\n{"time": 2.0}\n')
+    r = run(rvc, f"file:{f}", "--time-source", "stamps", "--json", "--timeout", "0")
+    assert r.returncode == 3, r.stderr
+    final = json.loads(r.stdout.splitlines()[-1])
+    assert (final["received"], final["checked"], final["rejected"]) == (7, 3, 4)
+    assert final["received"] == final["checked"] + final["rejected"]
+    assert "before the previous message's" in r.stderr
+    assert final["rate_hz"] == pytest.approx(2 / 1.0)
+
+
+def test_explicit_stamp_field_is_required(rvc, tmp_path):
+    f = tmp_path / "a.jsonl"
+    f.write_text('{"time": 1.0, "stamp": 0.9}\n{"time": 2.0}\n{"time": 3.0, "stamp": 2.5}\n')
+    r = run(rvc, f"file:{f}", "--time-source", "stamps", "--stamp-field", "stamp", "--json", "--timeout", "0")
+    assert r.returncode == 3
+    final = json.loads(r.stdout.splitlines()[-1])
+    assert (final["checked"], final["rejected"], final["latency_samples"]) == (2, 1, 2)
+    assert final["latency_mean_s"] == pytest.approx((0.1 + 0.5) / 2)
+    assert 'no field "stamp"' in r.stderr
+
+
+def test_nothing_received_is_not_success(rvc, tmp_path):
+    f = tmp_path / "empty.jsonl"
+    f.write_text("")
+    r = run(rvc, f"file:{f}", "--time-source", "stamps")
+    assert r.returncode == 6
+    assert "nothing was received" in r.stderr and "final state NotReceived" in r.stderr
+
+
+@pytest.mark.parametrize("text,needle", [
+    ("topics: [{topic: file:x, warn_rate: -1}]", "warn_rate must be a number >= 0"),
+    ("topics: [{topic: file:x, window_size: 1}]", "window_size must be a whole number"),
+    ("topics: [{topic: file:x, window_size: 2.5}]", "window_size must be a whole number"),
+    ("topics: [{topic: file:x, warn_rte: 1}]", "unknown key 'warn_rte'"),
+    ("warn_rate: fast\ntopics: [file:x]", "warn_rate must be a number"),
+    ("tpoics: [file:x]", "unknown key 'tpoics'"),
+    ("- file:x", "expected a map"),
+    ("topics: [file:x, file:x]", "listed twice"),
+    ("topics: [{warn_rate: 1}]", "without 'topic: URI'"),
+    ("topics: [{topic: file:x\n", "hz.yaml:"),
+])
+def test_bad_yaml_is_named(rvc, tmp_path, text, needle):
+    cfg = tmp_path / "hz.yaml"
+    cfg.write_text(text)
+    r = run(rvc, "--config", str(cfg))
+    assert r.returncode == 2, r.stderr
+    assert needle in r.stderr
+    assert "hz.yaml" in r.stderr or needle.startswith("--")
+
+
+@pytest.mark.parametrize("args,needle", [
+    (["--window", "1"], "--window"),
+    (["--time-source", "wall"], "--time-source"),
+    (["--warn-rate", "-2"], "--warn-rate"),
+    (["--period", "0"], "--period"),
+    ([], "no topic to watch"),
+    (["--type", "std_msgs/msg/Header"], "applies to dds: and zenoh:"),
+    (["--time-source", "stamps", "--stamp-field", "stamp", "--type", "std_msgs/msg/Nope"], "Nope"),
+])
+def test_bad_options_are_named(rvc, tmp_path, args, needle):
+    f = tmp_path / "a.jsonl"
+    f.write_text('{"time": 1}\n')
+    r = run(rvc, *([f"file:{f}"] if args else []), *args)
+    assert r.returncode == 2, (r.stdout, r.stderr)
+    assert needle in r.stderr
