@@ -31,6 +31,7 @@
 
 #include "cli/commands.hpp"
 #include "cli/hz_config.hpp"
+#include "cli/option_ranges.hpp"
 #include "cli/signals.hpp"
 #include "cli/transport_flags.hpp"
 #include "cli/type_options.hpp"
@@ -507,6 +508,10 @@ struct HzCommand {
 
 }  // namespace
 
+// Bounds of rvc hz's own numbers (docs/cli.md, "Numeric options").
+constexpr double kMaxRateHz = 1e9;
+constexpr double kMaxWindow = 10000000;
+
 Runner register_hz(CLI::App& app) {
   auto cmd = std::make_shared<HzCommand>();
   CLI::App* sub = app.add_subcommand(
@@ -517,13 +522,13 @@ Runner register_hz(CLI::App& app) {
       ->check(CLI::ExistingFile);
   cmd->typed.add_to(*sub, "Message type of the dds:/zenoh: samples: ROS 2 pkg/msg/Name (else JSON payloads)");
   sub->add_option("--warn-rate", cmd->flags.warn_rate, "WarnRate below this rate, Hz (default 0: off)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(in_range(0, kMaxRateHz, "Hz"));
   sub->add_option("--error-rate", cmd->flags.error_rate, "ErrorRate below this rate, Hz (default 0: off)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(in_range(0, kMaxRateHz, "Hz"));
   sub->add_option("--timeout", cmd->flags.timeout, "Timeout after this many seconds without a message (default 1; 0: off)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(in_range(0, kMaxSeconds, "seconds"));
   sub->add_option("--window", cmd->flags.window_size, "Arrivals the rate and jitter are computed over (default 10)")
-      ->check(CLI::Range(size_t{2}, size_t{10000000}));
+      ->check(in_range(2, kMaxWindow, "arrivals"));
   sub->add_option("--stamp-field", cmd->stamp_field,
                   "Latency = arrival - this field (a number of seconds or a Time); none: no latency (default: "
                   "header.stamp or stamp of a typed message, \"time\" of JSON where present)");
@@ -532,15 +537,16 @@ Runner register_hz(CLI::App& app) {
       ->check(CLI::IsMember({"receive", "stamps"}));
   sub->add_option("--time-field", cmd->time_field, "With --time-source stamps: the field read as arrival time (default time)");
   sub->add_option("--period", cmd->period, "Seconds between reports and /diagnostics (default 1)")
-      ->check(CLI::Range(0.01, 3600.0));
+      ->check(in_range(0.01, 3600, "seconds"));
   sub->add_flag("--json", cmd->json, "One JSON object per topic per period instead of the table");
   sub->add_option("--diagnostics", cmd->diagnostics,
                   "Publish diagnostic_msgs/DiagnosticArray here, e.g. dds:/diagnostics, zenoh:diagnostics "
                   "(CDR), file:PATH (JSON lines); repeatable");
   sub->add_option("--count,-n", cmd->count, "Stop after this many messages in all");
-  sub->add_option("--duration", cmd->duration, "Stop after this many seconds")->check(CLI::NonNegativeNumber);
+  sub->add_option("--duration", cmd->duration, "Stop after this many seconds")
+      ->check(in_range(0, kMaxSeconds, "seconds"));
   sub->add_option("--idle-timeout", cmd->idle_timeout, "Stop after this many seconds without any message")
-      ->check(CLI::NonNegativeNumber);
+      ->check(in_range(0, kMaxSeconds, "seconds"));
   sub->footer("Exit status: 0 every topic ended OK or WarnRate, 1 some topic ended NotReceived, ErrorRate or Timeout, "
               "3 messages were refused, 6 nothing arrived at all.");
   add_transport_options(*sub, cmd->transports);

@@ -25,8 +25,10 @@ struct YamlFile {
   }
   double number(const YAML::Node& n, const std::string& key) const {
     double v = -1;
-    if (!n.IsScalar() || !YAML::convert<double>::decode(n, v) || !std::isfinite(v) || v < 0)
-      fail(n, key + " must be a number >= 0 (0: off), got '" + (n.IsScalar() ? n.Scalar() : std::string("a list or map")) +
+    // The command line's bounds: rates to 1e9 Hz, a timeout to a week.
+    const double max = key == "timeout" ? 86400.0 * 7 : 1e9;
+    if (!n.IsScalar() || !YAML::convert<double>::decode(n, v) || !std::isfinite(v) || v < 0 || v > max)
+      fail(n, key + " must be a number from 0 (off) to " + (key == "timeout" ? std::string("604800") : std::string("1e9")) + ", got '" + (n.IsScalar() ? n.Scalar() : std::string("a list or map")) +
                   "'");
     return v;
   }

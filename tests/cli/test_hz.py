@@ -175,8 +175,10 @@ def test_nothing_received_is_not_success(rvc, tmp_path):
 
 
 @pytest.mark.parametrize("text,needle", [
-    ("topics: [{topic: file:x, warn_rate: -1}]", "warn_rate must be a number >= 0"),
+    ("topics: [{topic: file:x, warn_rate: -1}]", "warn_rate must be a number from 0"),
     ("topics: [{topic: file:x, window_size: 1}]", "window_size must be a whole number"),
+    ("topics: [{topic: file:x, timeout: 1e9}]", "timeout must be a number from 0 (off) to 604800"),
+    ("error_rate: .nan\ntopics: [file:x]", "error_rate must be a number"),
     ("topics: [{topic: file:x, window_size: 2.5}]", "window_size must be a whole number"),
     ("topics: [{topic: file:x, warn_rte: 1}]", "unknown key 'warn_rte'"),
     ("warn_rate: fast\ntopics: [file:x]", "warn_rate must be a number"),
@@ -200,6 +202,8 @@ def test_bad_yaml_is_named(rvc, tmp_path, text, needle):
     (["--time-source", "wall"], "--time-source"),
     (["--warn-rate", "-2"], "--warn-rate"),
     (["--period", "0"], "--period"),
+    (["--timeout", "nan"], "--timeout"),
+    (["--duration", "-1"], "--duration"),
     ([], "no topic to watch"),
     (["--type", "std_msgs/msg/Header"], "applies to dds: and zenoh:"),
     (["--time-source", "stamps", "--stamp-field", "stamp", "--type", "std_msgs/msg/Nope"], "Nope"),
