@@ -473,8 +473,10 @@ struct HzCommand {
       if (duration > 0 && now_steady >= duration) finished = true;
       if (idle_timeout > 0 && now_steady - last_message >= idle_timeout) finished = true;
     }
-    for (auto& t : topics) t->source->stop();
+    // Close first: a transport thread blocked on a full queue (a file read
+    // ahead of --count) returns at once, so stop() can join it.
     queue.close();
+    for (auto& t : topics) t->source->stop();
 
     const double now = stamps_mode() ? (stamp_now > -kNever ? stamp_now : 0) : since_start(SteadyClock::now());
     report(now, true);

@@ -214,3 +214,15 @@ def test_bad_options_are_named(rvc, tmp_path, args, needle):
     r = run(rvc, *([f"file:{f}"] if args else []), *args)
     assert r.returncode == 2, (r.stdout, r.stderr)
     assert needle in r.stderr
+
+
+def test_count_ends_a_run_reading_ahead(rvc, tmp_path):
+    # 20,000 lines: the reading thread fills the queue long before --count is reached; the run must
+    # still end (the queue is closed before the sources are stopped) with exactly N counted.
+    f = tmp_path / "big.jsonl"
+    f.write_text("".join('{"time": %r}\n' % (i * 0.01) for i in range(20000)))
+    r = run(rvc, f"file:{f}", "--time-source", "stamps", "--count", "5", "--json", timeout=30)
+    assert r.returncode == 0, r.stderr
+    final = json.loads(r.stdout.splitlines()[-1])
+    assert (final["received"], final["window"]) == (5, 5)
+    assert final["rate_hz"] == pytest.approx(4 / 0.04)
