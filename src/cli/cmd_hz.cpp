@@ -368,6 +368,53 @@ struct HzCommand {
                        [&](const auto& t) { return t->stats.state(now) != t->reported; });
   }
 
+  // --- files in time order ---------------------------------------------------
+  //
+  // With --time-source stamps and only files, the files are read here, on
+  // this thread, merged by their time field (a k-way merge): the same files
+  // give the same reports, however the threads would have raced. A line
+  // whose time cannot be read goes first (it is refused when processed).
+  struct Head {
+    bool have = false, ended = false, timed = false;
+    double time = 0;
+    Arrival arrival;
+  };
+  std::vector<Head> heads;
+  bool merged() const { return !heads.empty(); }
+
+  // The next arrival in time order into `out` (empty once every file ended).
+  void pull_merged(std::vector<Arrival>& out) {
+    out.clear();
+    for (uint32_t i = 0; i < heads.size(); ++i) {
+      Head& h = heads[i];
+      while (!h.have && !h.ended && !stop_requested()) {
+        transport::Frame f;
+        const auto r = topics[i]->source->pull(f);
+        if (r == transport::PullResult::End || (r == transport::PullResult::Frame && f.eos)) {
+          h.ended = true;
+        } else if (r == transport::PullResult::Frame) {
+          h.arrival = Arrival{i, false, SteadyClock::now(), wall_seconds(), std::string(f.payload)};
+          std::string error;
+          h.timed = topics[i]->arrival_field->read(h.arrival.payload, h.time, error) ==
+                    runtime::TimeFieldReader::Result::Ok;
+          h.have = true;
+        }  // Wait: a pipe with nothing yet; ask again
+      }
+    }
+    Head* first = nullptr;
+    for (Head& h : heads)
+      if (h.have && (!first || !h.timed || (first->timed && h.time < first->time))) {
+        first = &h;
+        if (!h.timed) break;
+      }
+    if (first) {
+      out.push_back(std::move(first->arrival));
+      first->have = false;
+      return;
+    }
+    for (uint32_t i = 0; i < heads.size(); ++i) topics[i]->ended = heads[i].ended;
+  }
+
   // --- the loop --------------------------------------------------------------
 
   int run() {
@@ -385,8 +432,11 @@ struct HzCommand {
     }
     install_stop_signals();
     ArrivalQueue queue(4096);
-    for (uint32_t i = 0; i < topics.size(); ++i)
-      topics[i]->source->start([&queue, i](const transport::Frame& f) { queue.push(i, f); });
+    if (stamps_mode() && std::all_of(topics.begin(), topics.end(), [](const auto& t) { return t->source->pullable(); }))
+      heads.resize(topics.size());
+    else
+      for (uint32_t i = 0; i < topics.size(); ++i)
+        topics[i]->source->start([&queue, i](const transport::Frame& f) { queue.push(i, f); });
 
     const auto start = SteadyClock::now();
     auto since_start = [&](SteadyClock::time_point p) { return std::chrono::duration<double>(p - start).count(); };
@@ -416,7 +466,8 @@ struct HzCommand {
       }
       if (duration > 0) wake = std::min(wake, duration);
       if (idle_timeout > 0) wake = std::min(wake, last_message + idle_timeout);
-      queue.pop_until(to_point(wake), batch);
+      if (merged()) pull_merged(batch);
+      else queue.pop_until(to_point(wake), batch);
 
       for (const Arrival& a : batch) {
         HzTopic& t = *topics[a.input];

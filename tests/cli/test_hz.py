@@ -88,40 +88,49 @@ def test_periodic_reports_match_python_on_the_same_stamps(rvc, tmp_path):
     assert "received 120 (checked 120, rejected 0), final state" in r.stderr
 
 
-def test_a_topic_that_stopped_times_out_and_fails_the_run(rvc, tmp_path):
+def test_two_files_merged_by_time_and_a_stopped_topic_times_out(rvc, tmp_path):
     a = write_topic(tmp_path / "a.jsonl", 60, 0.0, 0.1, seed=2)  # until ~6 s
     b = write_topic(tmp_path / "b.jsonl", 20, 0.0, 0.1, seed=3)  # stops at ~2 s
+    ua, ub = f"file:{tmp_path / 'a.jsonl'}", f"file:{tmp_path / 'b.jsonl'}"
     diag = tmp_path / "diag.jsonl"
-    r = run(rvc, f"file:{tmp_path / 'a.jsonl'}", f"file:{tmp_path / 'b.jsonl'}", "--time-source", "stamps",
-            "--stamp-field", "stamp", "--json", "--window", str(WINDOW), "--timeout", "0.5",
-            "--diagnostics", f"file:{diag}")
+    r = run(rvc, ua, ub, "--time-source", "stamps", "--stamp-field", "stamp", "--json", "--window", str(WINDOW),
+            "--timeout", "0.5", "--diagnostics", f"file:{diag}")
     assert r.returncode == 1, r.stderr  # a topic ended in an ERROR state
-    final = {o["topic"]: o for o in map(json.loads, r.stdout.splitlines()) if o["final"]}
+    reports = [json.loads(line) for line in r.stdout.splitlines()]
+    # Files are merged by time: every periodic report is exact for both topics.
+    start = min(a[0]["time"], b[0]["time"])
+    periodic = [p for p in reports if not p["final"]]
+    assert len(periodic) == 2 * 5
+    for p in periodic:
+        rows = a if p["topic"] == ua else b
+        seen = [row for row in rows if row["time"] < p["t"]]
+        compare(p, expected(seen, p["t"], timeout=0.5))
+        assert (p["t"] - start) == pytest.approx(round(p["t"] - start), abs=1e-9)
+    final = {o["topic"]: o for o in reports if o["final"]}
     now = a[-1]["time"]
-    compare(final[f"file:{tmp_path / 'a.jsonl'}"], expected(a, now, timeout=0.5))
-    compare(final[f"file:{tmp_path / 'b.jsonl'}"], expected(b, now, timeout=0.5))
-    assert final[f"file:{tmp_path / 'b.jsonl'}"]["state"] == "Timeout"
-    assert final[f"file:{tmp_path / 'b.jsonl'}"]["level"] == "ERROR"
+    compare(final[ua], expected(a, now, timeout=0.5))
+    compare(final[ub], expected(b, now, timeout=0.5))
+    assert (final[ub]["state"], final[ub]["level"]) == ("Timeout", "ERROR")
     # The last DiagnosticArray: one status per topic, levels as topic_state_monitor's.
     arrays = [json.loads(line) for line in diag.read_text().splitlines()]
     last = arrays[-1]
     by_name = {s["name"]: s for s in last["status"]}
-    sb = by_name[f"rvc hz: file:{tmp_path / 'b.jsonl'}"]
-    sa = by_name[f"rvc hz: file:{tmp_path / 'a.jsonl'}"]
+    sa, sb = by_name[f"rvc hz: {ua}"], by_name[f"rvc hz: {ub}"]
     assert (sa["level"], sb["level"]) == (0, 2)
     values = {v["key"]: v["value"] for v in sb["values"]}
     assert values["status"] == "Timeout" and values["received"] == "20" and values["window_size"] == str(WINDOW)
     assert float(values["rate_hz"]) == pytest.approx(expected(b, now)["rate_hz"], rel=1e-12)
     assert last["header"]["stamp"]["sec"] == int(now)
-    # Before b's first message it was NotReceived (ERROR too); it turned Timeout once a's stamps passed
-    # its deadline, published then. (Two files are read side by side: when exactly depends on the
-    # reading order; the final report does not.)
+    # b turned Timeout at the first instant rvc hz looked after its deadline (a message of a, or a
+    # report boundary), published then, not at the end.
     deadline = b[-1]["time"] + 0.5
+    boundaries = [start + k for k in range(1, 10) if start + k <= now]
+    first_look = min(t for t in [row["time"] for row in a] + boundaries if t > deadline)
     timeouts = [x for x in arrays if any(s["name"] == sb["name"] and s["message"].startswith("Timeout")
                                          for s in x["status"])]
-    assert timeouts
     stamp = timeouts[0]["header"]["stamp"]
-    assert stamp["sec"] + stamp["nanosec"] * 1e-9 > deadline - 1e-6
+    assert stamp["sec"] + stamp["nanosec"] * 1e-9 == pytest.approx(first_look, abs=2e-9)
+    assert stamp["sec"] + stamp["nanosec"] * 1e-9 < now
 
 
 def test_yaml_thresholds_per_topic_and_defaults(rvc, tmp_path):
