@@ -175,6 +175,14 @@ def test_explicit_stamp_field_is_required(rvc, tmp_path):
     assert 'no field "stamp"' in r.stderr
 
 
+def test_every_message_refused_is_not_success(rvc, tmp_path):
+    f = tmp_path / "a.jsonl"
+    f.write_text('{"x": 1}\n{"x": 2}\n')
+    r = run(rvc, f"file:{f}", "--time-source", "stamps", "--json")
+    assert r.returncode == 6, r.stderr
+    assert "every message was refused" in r.stderr and "received 2 (checked 0, rejected 2)" in r.stderr
+
+
 def test_nothing_received_is_not_success(rvc, tmp_path):
     f = tmp_path / "empty.jsonl"
     f.write_text("")
