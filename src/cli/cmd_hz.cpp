@@ -60,6 +60,7 @@ struct Arrival {
   SteadyClock::time_point steady;
   double wall = 0;
   std::string payload;
+  std::optional<double> time;  // its --time-field, when the file merge has read it already
 };
 
 // Transport threads -> the hz loop. Bounded: a full queue blocks the
@@ -375,8 +376,7 @@ struct HzCommand {
   // give the same reports, however the threads would have raced. A line
   // whose time cannot be read goes first (it is refused when processed).
   struct Head {
-    bool have = false, ended = false, timed = false;
-    double time = 0;
+    bool have = false, ended = false;
     Arrival arrival;
   };
   std::vector<Head> heads;
@@ -395,17 +395,18 @@ struct HzCommand {
         } else if (r == transport::PullResult::Frame) {
           h.arrival = Arrival{i, false, SteadyClock::now(), wall_seconds(), std::string(f.payload)};
           std::string error;
-          h.timed = topics[i]->arrival_field->read(h.arrival.payload, h.time, error) ==
-                    runtime::TimeFieldReader::Result::Ok;
+          double time = 0;
+          if (topics[i]->arrival_field->read(h.arrival.payload, time, error) == runtime::TimeFieldReader::Result::Ok)
+            h.arrival.time = time;
           h.have = true;
         }  // Wait: a pipe with nothing yet; ask again
       }
     }
     Head* first = nullptr;
     for (Head& h : heads)
-      if (h.have && (!first || !h.timed || (first->timed && h.time < first->time))) {
+      if (h.have && (!first || !h.arrival.time || (first->arrival.time && *h.arrival.time < *first->arrival.time))) {
         first = &h;
-        if (!h.timed) break;
+        if (!h.arrival.time) break;
       }
     if (first) {
       out.push_back(std::move(first->arrival));
@@ -479,8 +480,8 @@ struct HzCommand {
         double arrival = last_message;
         if (stamps_mode()) {
           std::string error;
-          double time = 0;
-          const auto r = t.arrival_field->read(a.payload, time, error);
+          double time = a.time.value_or(0);
+          const auto r = a.time ? runtime::TimeFieldReader::Result::Ok : t.arrival_field->read(a.payload, time, error);
           if (r != runtime::TimeFieldReader::Result::Ok) {
             refuse(t, error);
             ++total;
