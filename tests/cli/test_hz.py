@@ -243,3 +243,30 @@ def test_count_ends_a_run_reading_ahead(rvc, tmp_path):
     final = json.loads(r.stdout.splitlines()[-1])
     assert (final["received"], final["window"]) == (5, 5)
     assert final["rate_hz"] == pytest.approx(4 / 0.04)
+
+
+def test_sigint_flushes_the_final_report(rvc):
+    # stdin stays open (a live pipe): only the signal ends the run, with the final report and counts.
+    import signal
+    import time
+    p = subprocess.Popen([rvc, "hz", "-", "--json", "--period", "0.1", "--timeout", "0", "--stamp-field", "none"],
+                         stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        p.stdin.write('{"a": 1}\n{"a": 2}\n{"a": 3}\n')
+        p.stdin.flush()
+        seen = 0
+        deadline = time.time() + 30  # a guard, not a measurement
+        while seen < 3 and time.time() < deadline:
+            line = p.stdout.readline()
+            if line:
+                seen = json.loads(line)["received"]
+        assert seen == 3
+        p.send_signal(signal.SIGINT)
+        out, err = p.communicate(timeout=30)
+    finally:
+        if p.poll() is None:
+            p.kill()
+    final = [json.loads(l) for l in out.splitlines() if '"final":true' in l]
+    assert len(final) == 1 and final[0]["received"] == 3 and final[0]["state"] == "OK"
+    assert "rvc hz: -: received 3 (checked 3, rejected 0), final state OK" in err
+    assert p.returncode == 0
