@@ -30,7 +30,9 @@
 #include <vector>
 
 #include "cli/commands.hpp"
+#include "cli/hz_arrivals.hpp"
 #include "cli/hz_config.hpp"
+#include "cli/hz_report.hpp"
 #include "cli/option_ranges.hpp"
 #include "cli/signals.hpp"
 #include "cli/transport_flags.hpp"
@@ -45,59 +47,6 @@
 
 namespace rvc::cli {
 namespace {
-
-using SteadyClock = std::chrono::steady_clock;
-
-double wall_seconds() {
-  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
-}
-
-// One message as it arrived, with both clocks read on the transport thread:
-// a batch waiting in the queue must not look like a burst.
-struct Arrival {
-  uint32_t input = 0;
-  bool eos = false;
-  SteadyClock::time_point steady;
-  double wall = 0;
-  std::string payload;
-  std::optional<double> time;  // its --time-field, when the file merge has read it already
-};
-
-// Transport threads -> the hz loop. Bounded: a full queue blocks the
-// producer (backpressure, as transport::FrameQueue), nothing is dropped.
-class ArrivalQueue {
- public:
-  explicit ArrivalQueue(size_t capacity) : capacity_(capacity) {}
-  void push(uint32_t input, const transport::Frame& f) {
-    Arrival a{input, f.eos, SteadyClock::now(), wall_seconds(), std::string(f.payload)};
-    std::unique_lock<std::mutex> lock(mutex_);
-    not_full_.wait(lock, [&] { return items_.size() < capacity_ || closed_; });
-    if (closed_) return;
-    items_.push_back(std::move(a));
-    if (items_.size() == 1) not_empty_.notify_one();
-  }
-  // Waits until something arrived or `until`, then takes everything queued.
-  void pop_until(SteadyClock::time_point until, std::vector<Arrival>& out) {
-    out.clear();
-    std::unique_lock<std::mutex> lock(mutex_);
-    not_empty_.wait_until(lock, until, [&] { return !items_.empty() || closed_; });
-    out.swap(items_);
-    not_full_.notify_all();
-  }
-  void close() {
-    std::lock_guard<std::mutex> lock(mutex_);
-    closed_ = true;
-    not_full_.notify_all();
-    not_empty_.notify_all();
-  }
-
- private:
-  std::mutex mutex_;
-  std::condition_variable not_full_, not_empty_;
-  std::vector<Arrival> items_;
-  size_t capacity_;
-  bool closed_ = false;
-};
 
 std::string number_text(double v) {
   if (!std::isfinite(v)) return v > 0 ? "inf" : "nan";
@@ -247,99 +196,25 @@ struct HzCommand {
 
   // --- reports ---------------------------------------------------------------
 
-  void print_table(double now, bool final) {
-    if (!header_printed || final) {
-      std::printf("%-28s %10s %9s %9s %9s %6s %9s %9s %9s %9s %s\n", final ? "FINAL topic" : "topic", "rate_hz",
-                  "min_s", "max_s", "std_s", "window", "silence_s", "lat_mean", "lat_max", "received", "state");
-      header_printed = true;
-    }
-    for (const auto& t : topics) {
-      const runtime::RateSummary s = t->stats.summary(now);
-      auto col = [](double v, bool have) { return have ? number_fixed(v) : std::string("-"); };
-      const bool intervals = s.window >= 2;
-      std::printf("%-28s %10s %9s %9s %9s %6zu %9s %9s %9s %9llu %s\n", t->config.uri.c_str(),
-                  intervals ? number_fixed(s.rate, 3).c_str() : "-", col(s.interval_min, intervals).c_str(),
-                  col(s.interval_max, intervals).c_str(), col(s.interval_std, intervals).c_str(), s.window,
-                  col(s.silence, t->stats.any()).c_str(), col(s.latency_mean, s.latency_samples > 0).c_str(),
-                  col(s.latency_max, s.latency_samples > 0).c_str(), static_cast<unsigned long long>(t->received()),
-                  runtime::to_string(t->stats.state(now)));
-    }
-    std::fflush(stdout);
-  }
-
-  static std::string number_fixed(double v, int decimals = 5) {
-    char buf[64];
-    std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
-    return buf;
-  }
-
-  void print_json(double now, bool final) {
-    for (const auto& t : topics) {
-      const runtime::RateSummary s = t->stats.summary(now);
-      const runtime::TopicState state = t->stats.state(now);
-      io::JsonObject o;
-      o.add("t", now).add("topic", t->config.uri).add("state", runtime::to_string(state))
-          .add("level", io::to_string(runtime::diag_level(state)))
-          .add("received", t->received()).add("checked", s.received).add("rejected", t->rejected)
-          .add("window", static_cast<uint64_t>(s.window));
-      const bool intervals = s.window >= 2;
-      // null where there is nothing to compute from (JsonObject writes inf as null)
-      const double none = std::numeric_limits<double>::infinity();
-      o.add("rate_hz", intervals ? s.rate : none)
-          .add("interval_mean_s", intervals ? s.interval_mean : none)
-          .add("interval_std_s", intervals ? s.interval_std : none)
-          .add("interval_min_s", intervals ? s.interval_min : none)
-          .add("interval_max_s", intervals ? s.interval_max : none)
-          .add("silence_s", t->stats.any() ? s.silence : none)
-          .add("latency_samples", static_cast<uint64_t>(s.latency_samples))
-          .add("latency_mean_s", s.latency_samples ? s.latency_mean : none)
-          .add("latency_max_s", s.latency_samples ? s.latency_max : none)
-          .add("final", final);
-      std::printf("%s\n", o.str().c_str());
-    }
-    std::fflush(stdout);
+  std::vector<HzRow> rows() const {
+    std::vector<HzRow> out;
+    for (const auto& t : topics) out.push_back(HzRow{&t->config.uri, &t->stats, t->rejected});
+    return out;
   }
 
   void report(double now, bool final) {
-    if (json) print_json(now, final);
-    else print_table(now, final);
+    if (json) {
+      print_hz_json(stdout, rows(), now, final);
+    } else {
+      print_hz_table(stdout, rows(), now, final, !header_printed || final);
+      header_printed = true;
+    }
   }
 
   std::vector<io::DiagStatus> statuses(double now) {
     std::vector<io::DiagStatus> out;
-    for (const auto& t : topics) {
-      const runtime::RateSummary s = t->stats.summary(now);
-      const runtime::TopicState state = t->stats.state(now);
-      const auto& th = t->config.thresholds;
-      io::DiagStatus d;
-      d.level = runtime::diag_level(state);
-      d.name = "rvc hz: " + t->config.uri;
-      d.hardware_id = "rvc";
-      d.message = runtime::to_string(state);
-      if (state == runtime::TopicState::Timeout) d.message += ": no message for " + number_fixed(s.silence, 3) + " s";
-      if (state == runtime::TopicState::WarnRate || state == runtime::TopicState::ErrorRate)
-        d.message += ": " + number_fixed(s.rate, 3) + " Hz";
-      auto add = [&](const char* key, std::string value) { d.values.emplace_back(key, std::move(value)); };
-      const bool intervals = s.window >= 2;
-      add("topic", t->config.uri);
-      add("status", runtime::to_string(state));
-      add("rate_hz", intervals ? number_text(s.rate) : "");
-      add("warn_rate", number_text(th.warn_rate));
-      add("error_rate", number_text(th.error_rate));
-      add("timeout", number_text(th.timeout));
-      add("window_size", std::to_string(th.window_size));
-      add("window", std::to_string(s.window));
-      add("interval_min_s", intervals ? number_text(s.interval_min) : "");
-      add("interval_max_s", intervals ? number_text(s.interval_max) : "");
-      add("interval_std_s", intervals ? number_text(s.interval_std) : "");
-      add("silence_s", t->stats.any() ? number_text(s.silence) : "");
-      add("latency_mean_s", s.latency_samples ? number_text(s.latency_mean) : "");
-      add("latency_max_s", s.latency_samples ? number_text(s.latency_max) : "");
-      add("received", std::to_string(t->received()));
-      add("rejected", std::to_string(t->rejected));
-      out.push_back(std::move(d));
-      t->reported = state;
-    }
+    for (const HzRow& row : rows()) out.push_back(hz_status(row, now));
+    for (auto& t : topics) t->reported = t->stats.state(now);
     return out;
   }
 
@@ -393,7 +268,7 @@ struct HzCommand {
         if (r == transport::PullResult::End || (r == transport::PullResult::Frame && f.eos)) {
           h.ended = true;
         } else if (r == transport::PullResult::Frame) {
-          h.arrival = Arrival{i, false, SteadyClock::now(), wall_seconds(), std::string(f.payload)};
+          h.arrival = Arrival{i, false, SteadyClock::now(), wall_seconds(), std::string(f.payload), std::nullopt};
           std::string error;
           double time = 0;
           if (topics[i]->arrival_field->read(h.arrival.payload, time, error) == runtime::TimeFieldReader::Result::Ok)
