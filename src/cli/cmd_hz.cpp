@@ -95,8 +95,7 @@ struct HzCommand {
 
   // The topics with their types and stamp readers; false after printing why.
   bool prepare() {
-    if (!typed.type.empty() || !typed.msg_paths.empty())
-      for (const auto& p : typed.msg_paths) typed.registry.add_search_path(p);
+    for (const auto& p : typed.msg_paths) typed.registry.add_search_path(p);
     for (auto& config : hz_topics(config_path, inputs, flags)) {
       auto t = std::make_unique<HzTopic>(config);
       const std::string type_name = config.type.empty() ? typed.type : config.type;
@@ -180,7 +179,12 @@ struct HzCommand {
         case runtime::TimeFieldReader::Result::Missing:
           if (t.stamp_required) return refuse(t, error);
           break;
-        case runtime::TimeFieldReader::Result::Malformed: return refuse(t, error);
+        case runtime::TimeFieldReader::Result::Malformed:
+          // A typed sample that does not decode is no message of the topic;
+          // an untyped payload that is no JSON (plain text on a String
+          // topic) still arrived: without a stamp asked for, it counts.
+          if (t.stamp_required || t.type) return refuse(t, error);
+          break;
       }
     }
     t.stats.add(arrival, latency);

@@ -270,3 +270,18 @@ def test_sigint_flushes_the_final_report(rvc):
     assert len(final) == 1 and final[0]["received"] == 3 and final[0]["state"] == "OK"
     assert "rvc hz: -: received 3 (checked 3, rejected 0), final state OK" in err
     assert p.returncode == 0
+
+
+def test_plain_text_payloads_are_counted_without_latency(rvc, tmp_path):
+    # Receive time: a String topic's text (no JSON) still arrives; only an asked-for stamp refuses it.
+    f = tmp_path / "text.jsonl"
+    f.write_text("hello 1\nhello 2\n{\"time\": 5}\n")
+    r = run(rvc, f"file:{f}", "--json", "--timeout", "0")
+    assert r.returncode == 0, r.stderr
+    final = json.loads(r.stdout.splitlines()[-1])
+    assert (final["received"], final["checked"], final["rejected"]) == (3, 3, 0)
+    assert final["latency_samples"] == 1  # the one message with a "time"
+    r = run(rvc, f"file:{f}", "--json", "--timeout", "0", "--stamp-field", "time")
+    assert r.returncode == 3
+    final = json.loads(r.stdout.splitlines()[-1])
+    assert (final["received"], final["checked"], final["rejected"]) == (3, 1, 2)
