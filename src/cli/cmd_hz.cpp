@@ -141,8 +141,12 @@ struct HzCommand {
   std::unique_ptr<runtime::TimeFieldReader> field_reader(const HzTopic& t, const std::string& field, const char* what) {
     try {
       return std::make_unique<runtime::TimeFieldReader>(field, t.type);
-    } catch (const msg::MsgError& e) {
-      std::fprintf(stderr, "rvc: %s: %s '%s': %s\n", t.config.uri.c_str(), what, field.c_str(), e.what());
+    } catch (const msg::MsgError&) {
+      // (The decoder's own words speak of dense time and --time-field.)
+      std::string fields;
+      for (const auto& f : t.type->fields) fields += (fields.empty() ? "" : ", ") + f.name;
+      std::fprintf(stderr, "rvc: %s: %s '%s' is no number or builtin_interfaces/Time field of %s (its fields: %s)\n",
+                   t.config.uri.c_str(), what, field.c_str(), t.type->full_name().c_str(), fields.c_str());
       return nullptr;
     }
   }
