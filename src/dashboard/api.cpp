@@ -3,7 +3,9 @@
 #include <simdjson.h>
 
 #include <algorithm>
+#include <atomic>
 #include <charconv>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -122,6 +124,18 @@ constexpr int64_t kMaxId = INT64_MAX / 2;
 
 // --- runs -------------------------------------------------------------------
 
+std::atomic<double> g_silent_after{10};
+
+// No end recorded and nothing recorded for longer than --silent-after.
+bool silent(const Row& r) {
+  if (!r[5].empty()) return false;
+  const std::string& last = r[11].empty() ? r[4] : r[11];
+  double at = 0;
+  if (last.empty() || !parse_number(last, at)) return false;
+  const double now = std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+  return now - at > g_silent_after.load();
+}
+
 bool run_exists(Database& db, const std::string& run) {
   return !db.query("SELECT 1 FROM runs WHERE run = ?", {run}).empty();
 }
@@ -150,7 +164,8 @@ io::JsonObject run_object(const Row& r) {
       .add_raw("last_counters_at", json_wall(r[11]))
       // No end recorded yet: the monitor is running (or died without one;
       // the page shows how long it has been silent from last_counters_at).
-      .add("live", r[5].empty());
+      .add("live", r[5].empty())
+      .add("silent", silent(r));
   return o;
 }
 
@@ -431,6 +446,8 @@ bool parse_event_id(const std::string& text, EventCursor& cursor) {
 }
 
 }  // namespace
+
+void set_silent_after(double seconds) { g_silent_after = seconds; }
 
 Response error_response(int status, std::string_view message) {
   return Response{status, io::JsonObject().add("error", message).add("status", status).str()};
