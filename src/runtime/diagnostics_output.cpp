@@ -58,13 +58,16 @@ void DiagnosticsOutput::on_verdict(const engine::Verdict& v) {
   auto it = index_.find(v.property);
   if (it == index_.end()) return;
   PropertyState& p = properties_[it->second];
-  if (!v.value && (!p.has_verdict || p.value)) ++p.violations;
+  // Only a first verdict or a new value can change a level (with --all
+  // most verdicts repeat the last one: no statuses are built for them).
+  const bool changed = !p.has_verdict || p.value != v.value;
+  if (!v.value && changed) ++p.violations;
   p.has_verdict = true;
   p.value = v.value;
   p.verdict_time = v.time;
   ++p.verdicts;
   // A verdict's level change goes out at once (the counters as of the last tick).
-  if (levels(health_) != last_levels_) publish(health_);
+  if (changed && levels(health_) != last_levels_) publish(health_);
 }
 
 void DiagnosticsOutput::on_tick(const MonitorLoop& loop, std::chrono::steady_clock::time_point now) {
