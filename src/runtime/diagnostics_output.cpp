@@ -66,15 +66,26 @@ void DiagnosticsOutput::on_verdict(const engine::Verdict& v) {
   p.value = v.value;
   p.verdict_time = v.time;
   ++p.verdicts;
-  // A verdict's level change goes out at once (the counters as of the last tick).
-  if (changed && levels(health_) != last_levels_) publish(health_);
+  // A level change goes out at once (with the counters of the last tick),
+  // unless an array went out less than kMinGap ago: then the next tick
+  // sends it, so a property that flips on every message costs at most 10
+  // arrays a second, not one per message.
+  if (!changed) return;
+  const auto now = std::chrono::steady_clock::now();
+  if (now - last_any_ >= kMinGap && levels(health_) != last_levels_) {
+    publish(health_);
+    last_any_ = now;
+  }
 }
 
 void DiagnosticsOutput::on_tick(const MonitorLoop& loop, std::chrono::steady_clock::time_point now) {
-  health_ = loop.health(now);
   const bool due = now - last_publish_ >= std::chrono::duration<double>(options_.period);
+  if (!due && now - last_check_ < kMinGap) return;  // the loop ticks after every batch: look 10 times a second
+  last_check_ = now;
+  health_ = loop.health(now);
   if (due || levels(health_) != last_levels_) {
     publish(health_);
+    last_any_ = now;
     if (due) {
       last_publish_ = now;
       since_ = health_;

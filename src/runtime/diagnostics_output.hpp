@@ -61,7 +61,11 @@ class DiagnosticsOutput {
   LoopHealth health_;        // at the last tick: what a verdict's immediate array reports
   LoopHealth since_;         // at the last periodic array: the monitor's WARN compares with it
   std::vector<io::DiagLevel> last_levels_;
-  std::chrono::steady_clock::time_point last_publish_{};
+  // At most one array per kMinGap outside the period (level changes).
+  static constexpr std::chrono::milliseconds kMinGap{100};
+  std::chrono::steady_clock::time_point last_publish_{};  // the last periodic array
+  std::chrono::steady_clock::time_point last_any_{};      // the last array of any kind
+  std::chrono::steady_clock::time_point last_check_{};    // the last tick that looked at the levels
   uint64_t published_ = 0;
 };
 
