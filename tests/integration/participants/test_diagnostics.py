@@ -5,7 +5,8 @@ one is seen (docs/diagnostics.md).
 Independent decoders of what rvc publishes (neither uses rvc's encoder):
 - DDS: CycloneDDS's Python binding reads rt/diagnostics with an IdlStruct of DiagnosticArray
   declared here (as rosidl maps the .msg), with a ROS 2 subscriber's default QoS;
-- Zenoh: the CDR payload is deserialized by rosbags with its own diagnostic_msgs types.
+- Zenoh: each CDR payload is deserialized by rosbags with its own diagnostic_msgs types, and by
+  the same IdlStruct; both must agree.
 Liveliness: a cyclonedds reader that requests a 1.5 s lease (it matches only a writer offering at
 most that) sees the writer lose liveliness after SIGKILL; a Zenoh liveliness subscriber sees the
 token rvc/monitors/<name> appear, and go after SIGKILL.
@@ -50,15 +51,8 @@ def check_violated(st, name, received_at_least):
 
 # ---------------------------------------------------------------- DDS
 
-@pytest.fixture
-def dds_types(rvc, tmp_path, monkeypatch):
-    if "dds" not in transports_built(rvc):
-        pytest.skip("rvc built without DDS")
-    cfg = tmp_path / "cyclonedds.xml"
-    subprocess.run([rvc, "dds-config", "-o", str(cfg)], check=True)
-    assert 'name="lo"' in cfg.read_text()
-    monkeypatch.setenv("CYCLONEDDS_URI", f"file://{cfg}")  # before any Python participant exists
-    pytest.importorskip("cyclonedds")
+def diagnostic_idl_types():
+    """DiagnosticArray and std_msgs/String as cyclonedds IdlStructs, as rosidl maps the .msg files."""
     from dataclasses import dataclass
 
     from cyclonedds.idl import IdlStruct
@@ -97,6 +91,18 @@ def dds_types(rvc, tmp_path, monkeypatch):
         data: str
 
     return DiagnosticArray_, String_
+
+
+@pytest.fixture
+def dds_types(rvc, tmp_path, monkeypatch):
+    if "dds" not in transports_built(rvc):
+        pytest.skip("rvc built without DDS")
+    cfg = tmp_path / "cyclonedds.xml"
+    subprocess.run([rvc, "dds-config", "-o", str(cfg)], check=True)
+    assert 'name="lo"' in cfg.read_text()
+    monkeypatch.setenv("CYCLONEDDS_URI", f"file://{cfg}")  # before any Python participant exists
+    pytest.importorskip("cyclonedds")
+    return diagnostic_idl_types()
 
 
 def ros2_default_reader_qos():
@@ -202,15 +208,17 @@ def zenoh_rosbags(rvc):
         pytest.skip("rvc built without Zenoh")
     zenoh = pytest.importorskip("zenoh")
     typesys = pytest.importorskip("rosbags.typesys")
+    pytest.importorskip("cyclonedds")  # its IdlStruct decodes the same payloads too
     return zenoh, typesys.get_typestore(typesys.Stores.ROS2_HUMBLE)
 
 
 def test_zenoh_diagnostics_decode_with_rosbags_and_token_goes_when_killed(rvc, tmp_path, zenoh_rosbags):
     zenoh, store = zenoh_rosbags
+    DiagnosticArray_, _ = diagnostic_idl_types()
     ep = f"tcp/127.0.0.1:{free_port()}"
     mon = subprocess.Popen([rvc, "monitor", *SPECS, "--input", "zenoh:rvc/diag/in", "--output", f"file:{tmp_path}/v",
                             "--diagnostics", "zenoh:diagnostics", "--name", "zmon", "--diagnostics-period", "0.2",
-                            "--mode", "peer", "--listen", ep, "--no-multicast-scouting"],
+                            "--stale-after", "1.5", "--mode", "peer", "--listen", ep, "--no-multicast-scouting"],
                            stderr=subprocess.PIPE, text=True)
     s = None
     try:
@@ -219,10 +227,13 @@ def test_zenoh_diagnostics_decode_with_rosbags_and_token_goes_when_killed(rvc, t
         tokens = []  # (kind, key) as the liveliness subscriber sees them
         token_sub = s.liveliness().declare_subscriber(
             "rvc/monitors/**", lambda sample: tokens.append((sample.kind, str(sample.key_expr))), history=True)
-        arrays = []
-        diag_sub = s.declare_subscriber(
-            "diagnostics", lambda sample: arrays.append(
-                store.deserialize_cdr(sample.payload.to_bytes(), "diagnostic_msgs/msg/DiagnosticArray")))
+        arrays, idl_arrays = [], []  # the same payloads decoded by rosbags and by cyclonedds
+
+        def on_array(sample):
+            cdr = sample.payload.to_bytes()
+            idl_arrays.append(DiagnosticArray_.deserialize(cdr))
+            arrays.append(store.deserialize_cdr(cdr, "diagnostic_msgs/msg/DiagnosticArray"))
+        diag_sub = s.declare_subscriber("diagnostics", on_array)
         pub = s.declare_publisher("rvc/diag/in")
         wait_for(lambda: bool(getattr(pub.matching_status, "matching", False)), "rvc monitor to match")
         wait_for(lambda: (zenoh.SampleKind.PUT, "rvc/monitors/zmon") in tokens, "rvc's liveliness token")
@@ -240,6 +251,14 @@ def test_zenoh_diagnostics_decode_with_rosbags_and_token_goes_when_killed(rvc, t
         wait_for(seen(violated), "p1 violated, with the 4 messages counted")
         check_violated(next(st for st in map(lambda a: by_name(a.status), reversed(list(arrays))) if violated(st)),
                        "zmon", 4)
+        # Nothing more comes: after --stale-after the properties are STALE, the monitor WARNs.
+        wait_for(seen(lambda st: st["rvc: zmon/p1"][0] == STALE and st["rvc: zmon/p2"][0] == STALE
+                      and st["rvc: zmon/monitor"][0] == WARN), "STALE after 1.5 s of silence")
+        stale = next(by_name(a.status) for a in reversed(list(arrays)) if by_name(a.status)["rvc: zmon/p1"][0] == STALE)
+        assert stale["rvc: zmon/p1"][1].startswith("no message on zenoh:rvc/diag/in for ")
+        assert stale["rvc: zmon/p1"][3]["verdict"] == "false"  # the last verdict is still shown
+        n = min(len(arrays), len(idl_arrays))
+        assert n >= 3 and [by_name(a.status) for a in arrays[:n]] == [by_name(a.status) for a in idl_arrays[:n]]
         assert (zenoh.SampleKind.DELETE, "rvc/monitors/zmon") not in tokens
         mon.send_signal(signal.SIGKILL)
         mon.wait(timeout=HANG_GUARD)
