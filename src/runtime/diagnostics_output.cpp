@@ -70,7 +70,8 @@ void DiagnosticsOutput::on_verdict(const engine::Verdict& v) {
   // unless an array went out less than kMinGap ago: then the next tick
   // sends it, so a property that flips on every message costs at most 10
   // arrays a second, not one per message.
-  if (!changed) return;
+  // Before the loop's first tick there are no counters yet: that tick sends the first array.
+  if (!changed || health_.inputs.empty()) return;
   const auto now = std::chrono::steady_clock::now();
   if (now - last_any_ >= kMinGap && levels(health_) != last_levels_) {
     publish(health_);
@@ -81,8 +82,13 @@ void DiagnosticsOutput::on_verdict(const engine::Verdict& v) {
 void DiagnosticsOutput::on_tick(const MonitorLoop& loop, std::chrono::steady_clock::time_point now) {
   const bool due = now - last_publish_ >= std::chrono::duration<double>(options_.period);
   if (!due && now - last_check_ < kMinGap) return;  // the loop ticks after every batch: look 10 times a second
+  on_health(loop.health(now), now);
+}
+
+void DiagnosticsOutput::on_health(LoopHealth health, std::chrono::steady_clock::time_point now) {
+  const bool due = now - last_publish_ >= std::chrono::duration<double>(options_.period);
   last_check_ = now;
-  health_ = loop.health(now);
+  health_ = std::move(health);
   if (due || levels(health_) != last_levels_) {
     publish(health_);
     last_any_ = now;

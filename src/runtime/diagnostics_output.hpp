@@ -44,6 +44,9 @@ class DiagnosticsOutput {
   // The loop's tick (engine thread): publishes every `period`, and when a
   // property went STALE or came back.
   void on_tick(const MonitorLoop& loop, std::chrono::steady_clock::time_point now);
+  // What on_tick does with the loop's health (public for tests): publishes
+  // when the period is due or a level changed.
+  void on_health(LoopHealth health, std::chrono::steady_clock::time_point now);
   // The last array (with the final counters), flushed. Throws as a Sink.
   void finish(const MonitorLoop& loop);
 

@@ -11,7 +11,6 @@
 #include <stdexcept>
 #include <chrono>
 #include <string>
-#include <thread>
 #include <unistd.h>
 
 #include "io/properties_file.hpp"
@@ -140,23 +139,36 @@ TEST(DiagnosticsOutput, PublishesAtOnceOnALevelChangeOnly) {
   DiagnosticsOptions options;
   options.identity = kWho;
   options.levels["p1"] = io::DiagLevel::Warn;
+  options.period = 1;
+  options.stale_after = 5;
   DiagnosticsOutput out(std::move(outputs), {{"p1", "{a}"}, {"p2", "{b}"}}, options);
   const std::string p1 = "p1";
-  out.on_verdict({p1, 1, true});  // STALE (no verdict) -> OK
+  out.on_verdict({p1, 1, true});  // before the loop's first tick: no counters yet, nothing sent
+  EXPECT_EQ(got.size(), 0u);
+  // The ticks' times, in the past: a verdict's array is timed by the real clock, after them.
+  const auto start = std::chrono::steady_clock::now() - std::chrono::seconds(10);
+  out.on_health(one_input(0), start);  // the first tick: the period is due
   ASSERT_EQ(got.size(), 1u);
-  EXPECT_NE(got[0].find("\"name\":\"rvc: m1/p1\""), std::string::npos) << got[0];
-  out.on_verdict({p1, 2, true});  // still OK: nothing new to say before the period
+  EXPECT_NE(got[0].find("\"name\":\"rvc: m1/p1\",\"message\":\"holds\""), std::string::npos) << got[0];
+  out.on_health(one_input(0), start + std::chrono::milliseconds(500));  // period 1 s: not yet, nothing changed
   EXPECT_EQ(got.size(), 1u);
-  // Changes within 100 ms of an array wait for the loop's next tick (rate limit); after that
-  // gap one goes out at once.
-  std::this_thread::sleep_for(std::chrono::milliseconds(150));
+  out.on_health(one_input(0), start + std::chrono::milliseconds(1001));  // the period
+  EXPECT_EQ(got.size(), 2u);
+  out.on_health(one_input(6), start + std::chrono::milliseconds(1200));  // silent past stale_after: STALE at once
+  ASSERT_EQ(got.size(), 3u);
+  EXPECT_NE(got[2].find("\"level\":3,\"name\":\"rvc: m1/p1\""), std::string::npos) << got[2];
+  out.on_health(one_input(0), start + std::chrono::milliseconds(1300));  // a message again: OK
+  ASSERT_EQ(got.size(), 4u);
+  out.on_verdict({p1, 2, true});  // still OK: nothing new to say before the period
+  EXPECT_EQ(got.size(), 4u);
+  // More than 100 ms after the last array (the rate limit): a change goes out at once.
   out.on_verdict({p1, 3, false});  // OK -> WARN (marked warn)
-  ASSERT_EQ(got.size(), 2u);
-  EXPECT_NE(got[1].find("\"level\":1,\"name\":\"rvc: m1/p1\",\"message\":\"violated\""), std::string::npos) << got[1];
-  EXPECT_NE(got[1].find("{\"key\":\"violations\",\"value\":\"1\"}"), std::string::npos) << got[1];
+  ASSERT_EQ(got.size(), 5u);
+  EXPECT_NE(got[4].find("\"level\":1,\"name\":\"rvc: m1/p1\",\"message\":\"violated\""), std::string::npos) << got[4];
+  EXPECT_NE(got[4].find("{\"key\":\"violations\",\"value\":\"1\"}"), std::string::npos) << got[4];
   const std::string other = "not-a-property";
   out.on_verdict({other, 4, false});
-  EXPECT_EQ(got.size(), 2u);
+  EXPECT_EQ(got.size(), 5u);
 }
 
 std::string write_temp(const std::string& text) {
