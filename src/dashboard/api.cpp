@@ -420,11 +420,14 @@ int64_t max_id(Database& db, const char* table, const std::string& run) {
   return r.empty() ? 0 : std::strtoll(r[0][0].c_str(), nullptr, 10);
 }
 
-// Changes when a run starts or ends: then the stream sends the runs again.
+// Changes when a run starts, ends or goes silent (or records again): then
+// the stream sends the runs again. Only runs with no end can be silent.
 std::string runs_signature(Database& db) {
   QueryResult r = db.query("SELECT COUNT(*), MAX(started_at), COUNT(ended_at), MAX(ended_at) FROM runs");
   std::string sig;
   for (const auto& v : r.at(0)) sig += v + ",";
+  for (const Row& live : db.query(std::string(kRunSelect) + " WHERE r.ended_at IS NULL"))
+    if (silent(live)) sig += "silent:" + live[0] + ",";
   return sig;
 }
 

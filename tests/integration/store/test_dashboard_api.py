@@ -403,6 +403,24 @@ def test_events_announce_new_and_ended_runs(dash, db):
     ev.close()
 
 
+def test_events_announce_a_run_going_silent(db):
+    """No row changes: the run's last counters just grow older than --silent-after."""
+    execute(db, "INSERT INTO runs (run, command, started_at) VALUES ('r-quiet', 'rvc monitor', ?)", (time.time(),))
+    # Its last counters 3 s ahead: not silent while the dashboard starts and the stream connects.
+    execute(db, "INSERT INTO counters (run, wall, counters) VALUES ('r-quiet', ?, '{}')", (time.time() + 3,))
+    d = Dashboard("sqlite:" + db, "--silent-after", "1")
+    try:
+        assert next(r for r in d.get("/api/runs")[1]["runs"] if r["run"] == "r-quiet")["silent"] is False
+        ev = Events(d.port, "/api/events")
+        ev.resp.readline()
+        event = ev.next(timeout=30)
+        assert event is not None and event[0] == "run"
+        assert next(r for r in event[1] if r["run"] == "r-quiet")["silent"] is True
+        ev.close()
+    finally:
+        assert d.stop() == 0
+
+
 def test_events_bad_requests(dash):
     for path, status in [("/api/events?run=nope", 404), ("/api/events?run=r-mid&verdict=x", 400),
                          ("/api/events?run=", 400), ("/api/events?runn=r-mid", 400)]:
