@@ -45,13 +45,13 @@ void DiagnosticsOutput::publish(const LoopHealth& health) {
   for (const auto& s : all) last_levels_.push_back(s.level);
   const double stamp = wall_now();
   std::string cdr, json;
+  ++published_;  // one sequence number per array on every sink (a Zenoh reader counts gaps by it)
   for (auto& o : outputs_) {
     std::string& payload = o.cdr ? cdr : json;
     if (payload.empty())
       payload = o.cdr ? io::diagnostic_array_cdr(stamp, all) : io::diagnostic_array_json(stamp, all);
-    o.sink->put(payload, ++published_);
+    o.sink->put(payload, published_);
   }
-  if (outputs_.empty()) ++published_;
 }
 
 void DiagnosticsOutput::on_verdict(const engine::Verdict& v) {

@@ -124,13 +124,35 @@ TEST(DiagnosticStatus, ViolationLevelNames) {
   EXPECT_THROW(parse_violation_level(""), std::invalid_argument);
 }
 
-// A sink that keeps what it is given.
+// A sink that keeps what it is given (and the sequence numbers).
 struct CapturingSink : transport::Sink {
   std::vector<std::string>* got;
-  explicit CapturingSink(std::vector<std::string>* g) : got(g) {}
-  void put(std::string_view payload, uint64_t) override { got->emplace_back(payload); }
+  std::vector<uint64_t>* seqs;
+  explicit CapturingSink(std::vector<std::string>* g, std::vector<uint64_t>* s = nullptr) : got(g), seqs(s) {}
+  void put(std::string_view payload, uint64_t seq) override {
+    got->emplace_back(payload);
+    if (seqs) seqs->push_back(seq);
+  }
   void put_eos(uint64_t) override {}
 };
+
+TEST(DiagnosticsOutput, EverySinkNumbersTheArraysOneByOne) {
+  // A Zenoh reader counts gaps by these numbers: each sink's must run 1, 2, 3 with no holes.
+  std::vector<std::string> got_a, got_b;
+  std::vector<uint64_t> seq_a, seq_b;
+  std::vector<DiagnosticsOutput::Output> outputs;
+  outputs.push_back({std::make_unique<CapturingSink>(&got_a, &seq_a), false});
+  outputs.push_back({std::make_unique<CapturingSink>(&got_b, &seq_b), true});
+  DiagnosticsOptions options;
+  options.identity = kWho;
+  DiagnosticsOutput out(std::move(outputs), {{"p1", "{a}"}}, options);
+  const auto start = std::chrono::steady_clock::now() - std::chrono::seconds(10);
+  for (int i = 0; i < 3; ++i) out.on_health(one_input(0), start + std::chrono::seconds(2 * i));
+  EXPECT_EQ(seq_a, (std::vector<uint64_t>{1, 2, 3}));
+  EXPECT_EQ(seq_b, (std::vector<uint64_t>{1, 2, 3}));
+  EXPECT_EQ(got_a.at(0).front(), '{');   // JSON
+  EXPECT_EQ(got_b.at(0).substr(0, 2), std::string("\0\1", 2));  // CDR, little endian
+}
 
 TEST(DiagnosticsOutput, PublishesAtOnceOnALevelChangeOnly) {
   std::vector<std::string> got;
