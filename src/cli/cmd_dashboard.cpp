@@ -8,6 +8,8 @@
 
 #include "cli/commands.hpp"
 #include "cli/signals.hpp"
+#include "cli/option_ranges.hpp"
+#include "dashboard/api.hpp"
 #include "dashboard/server.hpp"
 #include "store/database.hpp"
 
@@ -19,8 +21,10 @@ struct DashboardCommand {
   std::string listen = "127.0.0.1:8765";
   double poll = 0.2;
   bool allow_remote = false;
+  double silent_after = 10;
 
   int run() {
+    dashboard::set_silent_after(silent_after);
     if (!store::is_database_uri(db)) {
       std::fprintf(stderr, "rvc dashboard: --db '%s' is not a results database (sqlite:PATH or postgresql://...)\n",
                    db.c_str());
@@ -78,6 +82,11 @@ Runner register_dashboard(CLI::App& app) {
   sub->add_option("--poll", cmd->poll, "Seconds between looks for new rows (live updates)")
       ->capture_default_str()
       ->check(CLI::Range(0.05, 10.0));
+  sub->add_option("--silent-after", cmd->silent_after,
+                  "A run with no end recorded and no counters recorded for S seconds is shown as silent (its "
+                  "monitor died or hangs; a live one records them every second)")
+      ->capture_default_str()
+      ->check(in_range(0.5, kMaxSeconds, "seconds"));
   sub->add_flag("--allow-remote", cmd->allow_remote,
                 "Allow a non-loopback --listen address (the dashboard has no authentication)");
   sub->footer(

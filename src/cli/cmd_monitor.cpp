@@ -11,6 +11,7 @@
 #include "cli/check_options.hpp"
 #include "cli/option_ranges.hpp"
 #include "cli/commands.hpp"
+#include "cli/diagnostics_flags.hpp"
 #include "cli/store_options.hpp"
 #include "cli/transport_flags.hpp"
 #include "cli/signals.hpp"
@@ -62,6 +63,40 @@ struct MonitorCommand {
   std::unique_ptr<runtime::MessageFilter> filter;
   std::string forward_property;           // --forward: ROSMonitoring's filter action
   std::string forward_to;
+  DiagnosticsFlags health;                 // --diagnostics, --name, --level, liveliness
+  std::unique_ptr<runtime::DiagnosticsOutput> diagnostics;
+  std::shared_ptr<void> liveliness_token;  // rvc/monitors/<name> while the monitor runs
+
+  // The /diagnostics output (fed by the verdicts and the loop's ticks) and
+  // the Zenoh liveliness token, once the outputs are open.
+  int open_health(const std::vector<engine::PropertySpec>& properties, runtime::VerdictOutputs& verdicts,
+                  const std::vector<std::string>& input_uris) {
+    if (int status = health.open(properties, check.properties_file, transports, diagnostics)) return status;
+    if (diagnostics) verdicts.observe([this](const engine::Verdict& v) { diagnostics->on_verdict(v); });
+    std::vector<std::string> uris = input_uris;
+    uris.insert(uris.end(), outputs.begin(), outputs.end());
+    uris.insert(uris.end(), health.uris.begin(), health.uris.end());
+    liveliness_token = health.announce(uris, transports);
+    if (liveliness_token) std::fprintf(stderr, "rvc monitor: liveliness token %s\n", health.token_key().c_str());
+    return 0;
+  }
+  void attach_health(runtime::LoopOptions& lopts) {
+    if (diagnostics)
+      lopts.on_tick = [this](const runtime::MonitorLoop& loop, std::chrono::steady_clock::time_point now) {
+        diagnostics->on_tick(loop, now);
+      };
+  }
+  // The last array, with the final counters; a failing output fails the run.
+  void finish_health(runtime::Outcome& outcome, const runtime::MonitorLoop& loop) {
+    liveliness_token.reset();  // an orderly end: the token goes at once (a killed monitor's when its lease expires)
+    if (!diagnostics) return;
+    try {
+      diagnostics->finish(loop);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "rvc: error: %s\n", e.what());
+      outcome.runtime_failure = true;
+    }
+  }
 
   // The filter in front of the monitor, keyed per input by its topic or key.
   void set_filter(runtime::LoopOptions& lopts, const std::vector<std::string>& uris) {
@@ -206,6 +241,8 @@ struct MonitorCommand {
       for (const auto& uri : outputs)
         if (refuse_own_input(uri, in)) return true;
       if (!stats_output.empty() && refuse_own_input(stats_output, in)) return true;
+      for (const auto& uri : health.uris)
+        if (refuse_own_input(uri, in)) return true;
     }
     return false;
   }
@@ -215,6 +252,7 @@ struct MonitorCommand {
 #ifdef RVC_HAVE_DDS
     verdict_transports.dds.ros_type = verdict_msg_type();
 #endif
+    health.apply_lease(verdict_transports);
     if (int status = cli::open_outputs(outputs, verdict_transports, wait_subscribers, wait_timeout, "monitor", sinks))
       return status;
     if (!stats_output.empty()) stats_sink = transport::open_sink(stats_output, transports);
@@ -277,6 +315,7 @@ struct MonitorCommand {
     if (int status = open_outputs(sinks, stats_sink)) return status;
     runtime::VerdictOutputs verdicts = make_verdicts(std::move(sinks));
     if (int status = open_enforcer(properties, verdicts, uris)) return status;
+    if (int status = open_health(properties, verdicts, uris)) return status;
     runtime::PipelineOptions popts = check.pipeline_options();
     popts.position_name = files ? "line" : "seq";
     // --sets-output: what the properties saw, for `rvc check` to replay.
@@ -297,6 +336,7 @@ struct MonitorCommand {
     lopts.input_names = names;
     lopts.input = SyncFlags::joined_names(named);
     record_counters(lopts);
+    attach_health(lopts);
     set_filter(lopts, uris);
     runtime::MonitorLoop loop(pipeline, verdicts, stats_sink.get(), lopts);
     SyncFlags::Sources sources = SyncFlags::open_sources(named, per_input);
@@ -311,6 +351,7 @@ struct MonitorCommand {
       std::fprintf(stderr, "rvc: error: %s\n", e.what());
       outcome.runtime_failure = true;
     }
+    finish_health(outcome, loop);
     return finish_results(outcome, loop);
   }
 
@@ -340,6 +381,11 @@ struct MonitorCommand {
       return kUsage;
     }
     input = inputs.at(0);
+    if (bag && !health.uris.empty()) {
+      std::fprintf(stderr, "rvc: --diagnostics reports a live monitor's health; a bag (mcap:) is checked at once: "
+                           "drop --diagnostics\n");
+      return kUsage;
+    }
     auto properties = check.properties();
     if (refuse_own_inputs({input})) return kUsage;
     std::unique_ptr<transport::Sink> stats_sink;
@@ -347,6 +393,8 @@ struct MonitorCommand {
     if (int status = open_outputs(sinks, stats_sink)) return status;
     runtime::VerdictOutputs verdicts = make_verdicts(std::move(sinks));
     if (int status = open_enforcer(properties, verdicts, {input})) return status;
+    if (!bag)
+      if (int status = open_health(properties, verdicts, {input})) return status;
     runtime::PipelineOptions popts = check.pipeline_options();
     popts.position_name = "seq";
     if (transport::scheme_of(input) == "mcap") return run_bag(properties, popts, verdicts);
@@ -368,6 +416,7 @@ struct MonitorCommand {
 
     runtime::LoopOptions lopts = loop_options(transport::scheme_of(input) == "file");
     record_counters(lopts);
+    attach_health(lopts);
     set_filter(lopts, {input});
     // --forward: what passes the property goes on to <input>_mon.
     std::unique_ptr<runtime::Forwarder> forwarder;
@@ -396,6 +445,7 @@ struct MonitorCommand {
         outcome.runtime_failure = true;
       }
     }
+    finish_health(outcome, loop);
     return finish_results(outcome, loop);
   }
 };
@@ -417,6 +467,7 @@ Runner register_monitor(CLI::App& app) {
                   "database: sqlite:PATH or postgresql://... (docs/results.md)")
       ->allow_extra_args(false);
   cmd->store.add_to(*sub);
+  cmd->health.add_to(*sub);
   sub->add_option("--allow", cmd->filter_options.allow,
                   "Filter (repeatable): only messages whose key (a zenoh: sample's own key) or topic matches one of "
                   "these patterns reach the monitor; '*' one chunk, '**' any chunks (docs/filter.md)");

@@ -3,7 +3,9 @@
 #include <simdjson.h>
 
 #include <algorithm>
+#include <atomic>
 #include <charconv>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -122,6 +124,18 @@ constexpr int64_t kMaxId = INT64_MAX / 2;
 
 // --- runs -------------------------------------------------------------------
 
+std::atomic<double> g_silent_after{10};
+
+// No end recorded and nothing recorded for longer than --silent-after.
+bool silent(const Row& r) {
+  if (!r[5].empty()) return false;
+  const std::string& last = r[11].empty() ? r[4] : r[11];
+  double at = 0;
+  if (last.empty() || !parse_number(last, at)) return false;
+  const double now = std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+  return now - at > g_silent_after.load();
+}
+
 bool run_exists(Database& db, const std::string& run) {
   return !db.query("SELECT 1 FROM runs WHERE run = ?", {run}).empty();
 }
@@ -150,7 +164,8 @@ io::JsonObject run_object(const Row& r) {
       .add_raw("last_counters_at", json_wall(r[11]))
       // No end recorded yet: the monitor is running (or died without one;
       // the page shows how long it has been silent from last_counters_at).
-      .add("live", r[5].empty());
+      .add("live", r[5].empty())
+      .add("silent", silent(r));
   return o;
 }
 
@@ -405,11 +420,14 @@ int64_t max_id(Database& db, const char* table, const std::string& run) {
   return r.empty() ? 0 : std::strtoll(r[0][0].c_str(), nullptr, 10);
 }
 
-// Changes when a run starts or ends: then the stream sends the runs again.
+// Changes when a run starts, ends or goes silent (or records again): then
+// the stream sends the runs again. Only runs with no end can be silent.
 std::string runs_signature(Database& db) {
   QueryResult r = db.query("SELECT COUNT(*), MAX(started_at), COUNT(ended_at), MAX(ended_at) FROM runs");
   std::string sig;
   for (const auto& v : r.at(0)) sig += v + ",";
+  for (const Row& live : db.query(std::string(kRunSelect) + " WHERE r.ended_at IS NULL"))
+    if (silent(live)) sig += "silent:" + live[0] + ",";
   return sig;
 }
 
@@ -431,6 +449,8 @@ bool parse_event_id(const std::string& text, EventCursor& cursor) {
 }
 
 }  // namespace
+
+void set_silent_after(double seconds) { g_silent_after = seconds; }
 
 Response error_response(int status, std::string_view message) {
   return Response{status, io::JsonObject().add("error", message).add("status", status).str()};

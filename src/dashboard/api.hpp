@@ -35,6 +35,12 @@ using Params = std::multimap<std::string, std::string>;
 
 Response error_response(int status, std::string_view message);
 
+// A run with no end recorded whose last counters snapshot (or, before the
+// first, its start) is older than this many seconds is reported "silent":
+// its monitor has died or hangs (a live monitor records its counters every
+// second). `rvc dashboard --silent-after`; default 10 s.
+void set_silent_after(double seconds);
+
 // GET `path` (without its query string) under /api/, except /api/events.
 // Throws store::DbError when the database fails (the server answers 503).
 Response handle_api(store::Database& db, const std::string& path, const Params& params);

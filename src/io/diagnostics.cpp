@@ -59,6 +59,8 @@ std::string diagnostic_array_json(double stamp, const std::vector<DiagStatus>& s
       .str();
 }
 
+const msg::MessageType& diagnostic_array_type() { return array_type(); }
+
 std::string diagnostic_array_cdr(double stamp, const std::vector<DiagStatus>& statuses, std::string_view frame_id) {
   std::string sample, error;
   if (!json_to_cdr(array_type(), diagnostic_array_json(stamp, statuses, frame_id), sample, error))

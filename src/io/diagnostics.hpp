@@ -15,6 +15,10 @@
 #include <utility>
 #include <vector>
 
+namespace rvc::msg {
+struct MessageType;
+}
+
 namespace rvc::io {
 
 // diagnostic_msgs/msg/DiagnosticStatus levels (a byte on the wire).
@@ -46,5 +50,8 @@ std::string diagnostic_array_json(double stamp, const std::vector<DiagStatus>& s
 // (which would be a bug: every field is built here).
 std::string diagnostic_array_cdr(double stamp, const std::vector<DiagStatus>& statuses,
                                  std::string_view frame_id = "");
+
+// The bundled DiagnosticArray type (resolved once), for a DDS writer of it.
+const msg::MessageType& diagnostic_array_type();
 
 }  // namespace rvc::io

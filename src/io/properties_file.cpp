@@ -2,11 +2,15 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <cctype>
 #include <set>
 
 namespace rvc::io {
+namespace {
 
-std::vector<engine::PropertySpec> load_properties(const std::string& path) {
+// Both entry points: the properties, and (if `levels` is given) the `level:`
+// of those that have one.
+std::vector<engine::PropertySpec> load(const std::string& path, std::vector<PropertyLevel>* levels) {
   std::vector<YAML::Node> documents;
   try {
     documents = YAML::LoadAllFromFile(path);
@@ -47,11 +51,21 @@ std::vector<engine::PropertySpec> load_properties(const std::string& path) {
       } else if (item.IsMap() && item["spec"]) {
         for (const auto& kv : item) {
           const std::string key = kv.first.as<std::string>();
-          if (key != "name" && key != "spec")
-            throw PropertiesError(where(kv.first) + ": unknown key '" + key + "' (a property has 'name' and 'spec')");
+          if (key != "name" && key != "spec" && key != "level")
+            throw PropertiesError(where(kv.first) + ": unknown key '" + key +
+                                  "' (a property has 'name', 'spec' and optionally 'level')");
         }
         p.spec = text(item["spec"], "'spec'");
         if (item["name"]) p.name = text(item["name"], "'name'");
+        if (item["level"]) {
+          // The /diagnostics level of a violation (rvc monitor --diagnostics).
+          std::string level = text(item["level"], "'level'");
+          for (char& c : level) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+          if (level != "warn" && level != "error")
+            throw PropertiesError(where(item["level"]) + ": level '" + item["level"].as<std::string>() +
+                                  "': expected warn or error");
+          if (levels) levels->push_back({out.size(), level});
+        }
       } else {
         throw PropertiesError(where(item) + ": each property needs a 'spec' (and a 'name')");
       }
@@ -72,7 +86,19 @@ std::vector<engine::PropertySpec> load_properties(const std::string& path) {
     if (out[i].name.empty()) out[i].name = "p" + std::to_string(i + 1);
     if (!names.insert(out[i].name).second) throw PropertiesError(path + ": duplicate property name '" + out[i].name + "'");
   }
+  if (levels)
+    for (auto& l : *levels) l.name = out[l.index].name;
   return out;
+}
+
+}  // namespace
+
+std::vector<engine::PropertySpec> load_properties(const std::string& path) { return load(path, nullptr); }
+
+std::vector<PropertyLevel> load_property_levels(const std::string& path) {
+  std::vector<PropertyLevel> levels;
+  load(path, &levels);
+  return levels;
 }
 
 }  // namespace rvc::io

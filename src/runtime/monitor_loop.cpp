@@ -115,6 +115,27 @@ std::string MonitorLoop::stats_json() const {
   return out.add_fixed("first_at", first_at_, 6).add_fixed("done_at", wall_now(), 6).str();
 }
 
+LoopHealth MonitorLoop::health(std::chrono::steady_clock::time_point now) const {
+  LoopHealth h;
+  const PipelineStats& p = feed_.stats();
+  h.received = total(&transport::SeqCounters::received);
+  h.checked = p.accepted;
+  h.rejected = p.rejected;
+  h.dropped = feed_.lost();
+  h.gaps = total(&transport::SeqCounters::gaps);
+  h.duplicates = total(&transport::SeqCounters::duplicates);
+  h.verdicts = outputs_.count();
+  h.violations = feed_.violations();
+  for (size_t i = 0; i < counters_.size(); ++i) {
+    LoopHealth::Input in;
+    in.name = i < options_.input_names.size() ? options_.input_names[i] : options_.input;
+    in.received = counters_[i].received;
+    in.silent_for = i < input_last_.size() ? std::chrono::duration<double>(now - input_last_[i]).count() : 0;
+    h.inputs.push_back(std::move(in));
+  }
+  return h;
+}
+
 void MonitorLoop::publish_stats() {
   std::string js = stats_json();
   std::fprintf(stderr, "%s\n", js.c_str());
@@ -123,6 +144,7 @@ void MonitorLoop::publish_stats() {
 
 void MonitorLoop::handle(const transport::Frame& f) {
   transport::SeqCounters& counters = counters_[f.input];
+  if (f.input < input_last_.size()) input_last_[f.input] = batch_at_;
   if (f.eos) {
     // Several publishers: the input ends when each has ended.
     if (options_.sequence_numbers) counters.on_eos(f.seq, f.publisher);
@@ -169,11 +191,13 @@ void MonitorLoop::on_schedule(std::chrono::steady_clock::time_point now) {
     last_record_ = now;
     options_.on_record(stats_json());
   }
+  if (options_.on_tick) options_.on_tick(*this, now);
 }
 
 void MonitorLoop::process(const std::vector<transport::Source*>& sources) {
   counters_.assign(sources.size(), transport::SeqCounters{});
   input_eos_.assign(sources.size(), false);
+  input_last_.assign(sources.size(), std::chrono::steady_clock::now());
   for (auto& c : counters_) c.expect(options_.publishers);
   last_stats_ = last_record_ = std::chrono::steady_clock::now();
   if (feed_.reads_in_order()) return process_in_order(sources);
@@ -211,7 +235,7 @@ void MonitorLoop::process(const std::vector<transport::Source*>& sources) {
         break;
       }
     } else {
-      last_message = now;
+      last_message = batch_at_ = now;
       if (first_at_ == 0) first_at_ = wall_now();
       for (size_t i = 0; i < count; ++i) {
         const transport::OwnedFrame& o = batch[i];
@@ -268,7 +292,7 @@ void MonitorLoop::process_in_order(const std::vector<transport::Source*>& source
       feed_.input_ended(static_cast<uint32_t>(input));
       continue;
     }
-    last_message = now;
+    last_message = batch_at_ = now;
     if (first_at_ == 0) first_at_ = wall_now();
     f.input = static_cast<uint32_t>(input);
     handle(f);

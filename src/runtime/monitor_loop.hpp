@@ -24,6 +24,22 @@
 
 namespace rvc::runtime {
 
+class MonitorLoop;
+
+// What the loop has counted so far, for the monitor's health (the
+// /diagnostics output): totals since the start, and how long each input has
+// been silent.
+struct LoopHealth {
+  uint64_t received = 0, checked = 0, rejected = 0, dropped = 0, gaps = 0, duplicates = 0;
+  uint64_t verdicts = 0, violations = 0;
+  struct Input {
+    std::string name;
+    uint64_t received = 0;
+    double silent_for = 0;  // seconds since its last message (since the start before the first)
+  };
+  std::vector<Input> inputs;
+};
+
 struct LoopOptions {
   std::string input;             // the input's name in the counters line
   // Several inputs: their names (counters per input); empty with one input.
@@ -47,6 +63,9 @@ struct LoopOptions {
   // for the results store (apart from stats_interval, which prints them).
   std::function<void(const std::string&)> on_record;
   double record_interval = 1;
+  // Called on the engine thread at least every ~100 ms while the loop runs
+  // (the /diagnostics output publishes from it); may read loop.health().
+  std::function<void(const MonitorLoop& loop, std::chrono::steady_clock::time_point now)> on_tick;
   std::function<bool()> stop_requested = [] { return false; };   // e.g. SIGINT/SIGTERM seen
   std::function<bool()> stats_requested = [] { return false; };  // e.g. SIGUSR1 seen (true once)
 };
@@ -76,6 +95,8 @@ class MonitorLoop {
   std::string stats_json() const;
   const transport::SeqCounters& counters(size_t input = 0) const { return counters_[input]; }
   EndReason end_reason() const { return end_; }
+  // The counters and each input's silence at `now` (engine thread).
+  LoopHealth health(std::chrono::steady_clock::time_point now) const;
   // The counters printed at the end of run().
   const std::string& final_stats() const { return final_stats_; }
 
@@ -97,6 +118,9 @@ class MonitorLoop {
   LoopOptions options_;
   std::vector<transport::SeqCounters> counters_ = std::vector<transport::SeqCounters>(1);
   std::vector<bool> input_eos_ = std::vector<bool>(1);
+  std::vector<std::chrono::steady_clock::time_point> input_last_ =
+      std::vector<std::chrono::steady_clock::time_point>(1, std::chrono::steady_clock::now());
+  std::chrono::steady_clock::time_point batch_at_{};  // when the frames being handled arrived
   bool eos_ = false;
   EndReason end_ = EndReason::SourceClosed;
   std::string final_stats_;

@@ -281,6 +281,15 @@ test('an empty database: the first run appears and opens by itself', async () =>
   }
 });
 
+test('a run whose monitor died without an end is marked silent', async () => {
+  // Started a minute ago, no end and no counters since: rvc dashboard says "silent" (--silent-after 10).
+  sql(db, [['INSERT INTO runs (run, command, inputs, time_model, started_at) VALUES (?,?,?,?,?)',
+            ['r-dead', 'rvc monitor', '[]', 'discrete', Date.now() / 1000 - 60]]]);
+  const marker = page.locator('#runs li[data-run="r-dead"] .live-marker.silent');
+  await marker.waitFor({ timeout: 5000 });
+  assert.equal(await marker.innerText(), '● silent');
+});
+
 test('the page loaded nothing from anywhere else', () => {
   assert.deepEqual(foreign, []);
 });

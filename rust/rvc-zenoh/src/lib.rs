@@ -974,3 +974,54 @@ pub unsafe extern "C" fn rvc_zenoh_publisher_undeclare(p: *mut rvc_zenoh_publish
         Ok(RVC_ZENOH_OK)
     })
 }
+
+// ---------------------------------------------------------------------------
+// Liveliness token (a monitor announcing itself)
+// ---------------------------------------------------------------------------
+
+pub struct rvc_zenoh_token {
+    token: Option<LivelinessToken>,
+}
+
+/// Declares a liveliness token on `key`: liveliness subscribers see it appear
+/// now and disappear when it is undeclared or the session is gone (including
+/// the process being killed: its peers' transport lease expires).
+#[no_mangle]
+pub unsafe extern "C" fn rvc_zenoh_token_declare(
+    s: *const rvc_zenoh_session,
+    key: *const c_char,
+    out: *mut *mut rvc_zenoh_token,
+) -> c_int {
+    guard(|| {
+        let s = handle(s, "session")?;
+        let ke = keyexpr(cstr(key, "keyexpr")?)?;
+        let out = out_ptr(out, "out")?;
+        let token = s
+            .session
+            .liveliness()
+            .declare_token(ke.clone())
+            .wait()
+            .map_err(|e| ezenoh(&format!("declaring liveliness token '{ke}'"), e))?;
+        *out = Box::into_raw(Box::new(rvc_zenoh_token { token: Some(token) }));
+        Ok(RVC_ZENOH_OK)
+    })
+}
+
+/// Undeclares the token and frees the handle.
+#[no_mangle]
+pub unsafe extern "C" fn rvc_zenoh_token_undeclare(t: *mut rvc_zenoh_token) -> c_int {
+    if t.is_null() {
+        return RVC_ZENOH_OK;
+    }
+    guard(|| {
+        // SAFETY: produced by Box::into_raw in declare; freed once here.
+        let mut t = unsafe { Box::from_raw(t) };
+        if let Some(token) = t.token.take() {
+            token
+                .undeclare()
+                .wait()
+                .map_err(|e| ezenoh("undeclaring liveliness token", e))?;
+        }
+        Ok(RVC_ZENOH_OK)
+    })
+}

@@ -490,6 +490,8 @@ struct DdsSink::Impl {
                 "'. Subscribers must use the same domain, and a config pinned to the same interface "
                 "(rvc dds-config writes one for CYCLONEDDS_URI)";
     dds_qos_t* wq = make_qos(ep.qos, o.partition, false);
+    if (o.liveliness_lease.count() > 0)
+      ddsc().dds_qset_liveliness(wq, DDS_LIVELINESS_AUTOMATIC, DDS_MSECS(o.liveliness_lease.count()));
     writer = ddsc().dds_create_writer(ep.group, ep.topic, wq, nullptr);
     ddsc().dds_delete_qos(wq);
     if (writer < 0) fail("cannot create writer on '" + ep.name + "'", writer);

@@ -44,6 +44,11 @@ struct DdsOptions {
   // take CDR payloads and publish them as samples of the type. Typed topics
   // carry no end-of-stream marker (a ROS 2 publisher sends none).
   const msg::MessageType* ros_type = nullptr;
+  // Set by commands (rvc monitor --liveliness-lease), not a flag of every
+  // command: writers assert LIVELINESS AUTOMATIC with this lease, so a reader
+  // sees a killed writer lose liveliness once it expires. Zero: the DDS
+  // default (infinite). Readers keep the default, which accepts any lease.
+  std::chrono::milliseconds liveliness_lease{0};
 };
 
 

@@ -21,7 +21,7 @@ inline constexpr const char* kDdscSoname = RVC_DDSC_SONAME;
   X(dds_delete_listener) X(dds_delete_qos) X(dds_get_publication_matched_status) \
   X(dds_get_subscription_matched_status) X(dds_lset_requested_incompatible_qos) X(dds_istream_fini) X(dds_istream_init) \
   X(dds_lset_data_available) X(dds_qset_durability) X(dds_qset_durability_service) X(dds_qset_entity_name) \
-  X(dds_qset_history) X(dds_qset_partition1) X(dds_qset_reliability) X(dds_qset_resource_limits) \
+  X(dds_qset_history) X(dds_qset_liveliness) X(dds_qset_partition1) X(dds_qset_reliability) X(dds_qset_resource_limits) \
   X(dds_return_loan) X(dds_set_guardcondition) X(dds_set_listener) X(dds_set_status_mask) \
   X(dds_stream_free_sample) X(dds_stream_normalize_data) X(dds_stream_read) X(dds_strretcode) X(dds_take) \
   X(dds_takecdr) X(dds_wait_for_acks) X(dds_waitset_attach) X(dds_waitset_wait) X(dds_write) \

@@ -35,6 +35,7 @@ typedef struct rvc_zenoh_config rvc_zenoh_config;
 typedef struct rvc_zenoh_session rvc_zenoh_session;
 typedef struct rvc_zenoh_subscriber rvc_zenoh_subscriber;
 typedef struct rvc_zenoh_publisher rvc_zenoh_publisher;
+typedef struct rvc_zenoh_token rvc_zenoh_token;
 
 const char* rvc_zenoh_last_error(void);
 
@@ -125,6 +126,14 @@ int rvc_zenoh_publisher_wait_matched(const rvc_zenoh_publisher* p, size_t n, uin
  * the number that answered. 1 when complete, 0 on timeout, <0 on error. */
 int rvc_zenoh_publisher_flush(const rvc_zenoh_publisher* p, uint64_t timeout_ms, size_t* confirmed);
 int rvc_zenoh_publisher_undeclare(rvc_zenoh_publisher* p);
+
+/* ---- liveliness token ------------------------------------------------- */
+
+/* Declares a liveliness token on keyexpr (rvc monitor: "rvc/monitors/<name>").
+ * Liveliness subscribers see it until it is undeclared or the session ends
+ * (a killed process: when its peers' lease on it expires). */
+int rvc_zenoh_token_declare(const rvc_zenoh_session* s, const char* keyexpr, rvc_zenoh_token** out);
+int rvc_zenoh_token_undeclare(rvc_zenoh_token* t);
 
 #ifdef __cplusplus
 }

@@ -87,6 +87,10 @@ std::unique_ptr<Source> make_zenoh_source(std::string keyexpr, const ZenohOption
   return std::make_unique<ZenohSource>(ZenohSession::shared(opts), std::move(keyexpr));
 }
 
+std::shared_ptr<void> make_zenoh_liveliness_token(const std::string& keyexpr, const ZenohOptions& opts) {
+  return std::make_shared<ZenohLivelinessToken>(ZenohSession::shared(opts), keyexpr);
+}
+
 std::unique_ptr<Sink> make_zenoh_sink(std::string keyexpr, const ZenohOptions& opts) {
   auto sink = std::make_unique<ZenohSink>(ZenohSession::shared(opts), std::move(keyexpr), opts.express);
   sink->set_discovery(zenoh_discovery_summary(opts));

@@ -67,6 +67,9 @@ std::string zenoh_discovery_summary(const ZenohOptions& opts);
 // ZenohError when the session cannot be opened or the key is invalid.
 std::unique_ptr<Source> make_zenoh_source(std::string keyexpr, const ZenohOptions& opts);
 std::unique_ptr<Sink> make_zenoh_sink(std::string keyexpr, const ZenohOptions& opts);
+// A liveliness token on `keyexpr` in the shared session (rvc monitor
+// announcing itself); it lives as long as the returned object.
+std::shared_ptr<void> make_zenoh_liveliness_token(const std::string& keyexpr, const ZenohOptions& opts);
 
 // `rvc router`: a Zenoh router (mode forced to router; listens on
 // tcp/127.0.0.1:7447 unless --listen or a config file says otherwise) until

@@ -168,6 +168,18 @@ ZenohPublisher::ZenohPublisher(std::shared_ptr<ZenohSession> session, const std:
         "declaring publisher on '" + keyexpr + "'");
 }
 
+ZenohLivelinessToken::ZenohLivelinessToken(std::shared_ptr<ZenohSession> session, const std::string& keyexpr)
+    : session_(std::move(session)) {
+  if (!session_) throw ZenohError("zenoh: liveliness token needs a session");
+  check(rvc_zenoh_token_declare(session_->raw(), keyexpr.c_str(), &token_),
+        "declaring liveliness token '" + keyexpr + "'");
+}
+
+ZenohLivelinessToken::~ZenohLivelinessToken() {
+  if (token_ && rvc_zenoh_token_undeclare(token_) < 0)
+    std::fprintf(stderr, "rvc: zenoh: undeclaring liveliness token: %s\n", rvc_zenoh_last_error());
+}
+
 ZenohPublisher::~ZenohPublisher() {
   if (pub_ && rvc_zenoh_publisher_undeclare(pub_) < 0)
     std::fprintf(stderr, "rvc: zenoh: undeclaring publisher: %s\n", rvc_zenoh_last_error());

@@ -21,6 +21,7 @@ struct rvc_zenoh_config;
 struct rvc_zenoh_session;
 struct rvc_zenoh_subscriber;
 struct rvc_zenoh_publisher;
+struct rvc_zenoh_token;
 
 namespace rvc::transport {
 
@@ -117,6 +118,20 @@ class ZenohPublisher {
  private:
   std::shared_ptr<ZenohSession> session_;
   rvc_zenoh_publisher* pub_ = nullptr;
+};
+
+// A liveliness token: liveliness subscribers on a matching key see it while
+// it lives, and see it go when it is destroyed or the process dies.
+class ZenohLivelinessToken {
+ public:
+  ZenohLivelinessToken(std::shared_ptr<ZenohSession> session, const std::string& keyexpr);
+  ~ZenohLivelinessToken();
+  ZenohLivelinessToken(const ZenohLivelinessToken&) = delete;
+  ZenohLivelinessToken& operator=(const ZenohLivelinessToken&) = delete;
+
+ private:
+  std::shared_ptr<ZenohSession> session_;
+  rvc_zenoh_token* token_ = nullptr;
 };
 
 }  // namespace rvc::transport

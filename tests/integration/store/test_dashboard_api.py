@@ -204,9 +204,10 @@ def test_runs_newest_first(dash):
     assert mid == {"run": "r-mid", "command": "rvc check -p props.yaml mid.jsonl", "inputs": ["mid.jsonl"],
                    "time_model": "discrete", "started_at": 2000, "ended_at": 2050.5, "exit_status": 1,
                    "end_reason": "end of input", "final_counters": None, "violations": 3, "property_count": 3,
-                   "last_counters_at": None, "live": False}
+                   "last_counters_at": None, "live": False, "silent": False}
     assert old["final_counters"] == {"checked": 3} and old["violations"] == 0
     assert live["live"] is True and live["ended_at"] is None and live["exit_status"] is None
+    assert live["silent"] is True  # no end, and its last counters are from 1970
     assert live["last_counters_at"] == 3005.5 and live["inputs"] == ["a", "b"]
     status, body = dash.get("/api/runs?limit=2")
     assert [r["run"] for r in body["runs"]] == ["r-live", "r-mid"] and body["more"] is True
@@ -402,6 +403,24 @@ def test_events_announce_new_and_ended_runs(dash, db):
     ev.close()
 
 
+def test_events_announce_a_run_going_silent(db):
+    """No row changes: the run's last counters just grow older than --silent-after."""
+    execute(db, "INSERT INTO runs (run, command, started_at) VALUES ('r-quiet', 'rvc monitor', ?)", (time.time(),))
+    # Its last counters 3 s ahead: not silent while the dashboard starts and the stream connects.
+    execute(db, "INSERT INTO counters (run, wall, counters) VALUES ('r-quiet', ?, '{}')", (time.time() + 3,))
+    d = Dashboard("sqlite:" + db, "--silent-after", "1")
+    try:
+        assert next(r for r in d.get("/api/runs")[1]["runs"] if r["run"] == "r-quiet")["silent"] is False
+        ev = Events(d.port, "/api/events")
+        ev.resp.readline()
+        event = ev.next(timeout=30)
+        assert event is not None and event[0] == "run"
+        assert next(r for r in event[1] if r["run"] == "r-quiet")["silent"] is True
+        ev.close()
+    finally:
+        assert d.stop() == 0
+
+
 def test_events_bad_requests(dash):
     for path, status in [("/api/events?run=nope", 404), ("/api/events?run=r-mid&verdict=x", 400),
                          ("/api/events?run=", 400), ("/api/events?runn=r-mid", 400)]:
@@ -480,6 +499,50 @@ def test_database_written_by_rvc_check(tmp_path):
                                          "changes": 4, "violations": 2}]
     finally:
         assert d.stop() == 0
+
+
+def test_killed_monitor_run_is_reported_silent(tmp_path):
+    """A live monitor records counters every second, also without messages; once it is killed
+    (no end recorded) and nothing comes for --silent-after, the API says "silent"."""
+    db = tmp_path / "results.db"
+    mon = subprocess.Popen([rvc_binary(), "monitor", "-s", "{speed < 40}", "--input", "-", "--output",
+                            f"sqlite:{db}", "--output", f"file:{tmp_path}/v.jsonl"],
+                           stdin=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
+    d = None
+    try:
+        mon.stdin.write(json.dumps({"speed": 10}) + "\n")
+        mon.stdin.flush()
+
+        def counters_rows():
+            if not db.exists():
+                return 0
+            with sqlite3.connect(db) as c:
+                try:
+                    return c.execute("SELECT COUNT(*) FROM counters").fetchone()[0]
+                except sqlite3.OperationalError:  # the tables are not there yet
+                    return 0
+
+        deadline = time.monotonic() + 60
+        while counters_rows() < 3 and time.monotonic() < deadline:
+            time.sleep(0.1)
+        assert counters_rows() >= 3, "the monitor recorded no counters"
+        d = Dashboard(f"sqlite:{db}", "--silent-after", "4")
+        run = d.get("/api/runs")[1]["runs"][0]
+        assert run["live"] is True and run["silent"] is False  # records keep arriving
+        mon.kill()
+        mon.wait(timeout=30)
+        while time.monotonic() < deadline + 60:
+            run = d.get("/api/runs")[1]["runs"][0]
+            if run["silent"]:
+                break
+            time.sleep(0.2)
+        assert run["live"] is True and run["silent"] is True
+        assert d.get(f"/api/runs/{run['run']}")[1]["run"]["silent"] is True
+    finally:
+        if mon.poll() is None:
+            mon.kill()
+        if d is not None:
+            assert d.stop() == 0
 
 
 def test_explanations_kept_and_an_older_database_gains_their_column(tmp_path):
