@@ -444,8 +444,9 @@ class Parser {
       const char next = s_[pos_ + n];
       bool window = false;
       if (next == '[') {
-        const size_t close = s_.find(']', pos_ + n), colon = s_.find(':', pos_ + n);
-        window = colon != std::string::npos && (close == std::string::npos || colon < close);
+        // Scans only to the first ':' or ']', which the parse then consumes either way.
+        const size_t first = s_.find_first_of(":]", pos_ + n);
+        window = first != std::string::npos && s_[first] == ':';
       }
       if (next == '(' || window) {
         func = f;

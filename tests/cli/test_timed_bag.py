@@ -62,6 +62,8 @@ PROPERTIES = {
     "rate": ("{count[0:0.5](imu.@arrived) >= 4}", [(0, False), (1.1875, True), (2.3125, False), (2.6875, True)]),
     # latency: arrival (log time) - stamp is 1/64 s, then 0.25 s from 2.5 on; unknown before any message
     "latency": ("{imu.@latency < 0.125}", [(0, False), (1.0, True), (2.5, False)]),
+    # a typed field's window: imu's angle (0.1) has a sample in (t-0.25, t] except from 2.0 + 0.25 to 2.5
+    "angle": ("{min[0:0.25](imu.steering_tire_angle) > 0.05}", [(0, False), (1.0, True), (2.25, False), (2.5, True)]),
     # the steady topic never falls silent for 0.125 s: one verdict, true from its first message
     "gear": ("{gear.@age <= 0.125}", [(0, False), (1.03125, True)]),
 }
@@ -88,3 +90,10 @@ def test_a_gap_in_one_topic_is_reported_at_the_exact_instants(rvc, tmp_path, bag
     monitor = subprocess.run([rvc, "monitor", "--dense", "--properties", str(props), "--input", f"mcap:{bag}", *topics],
                              capture_output=True, text=True, timeout=120)
     assert verdicts(monitor.stdout) == want, monitor.stderr
+
+
+def test_an_aggregate_of_a_field_the_type_lacks_is_a_spec_error(rvc, bag):
+    r = subprocess.run([rvc, "check", "--dense", "--spec", "{imu.@age < 1} and {avg[0:1](imu.steering) > 0}", bag,
+                        "--topic", "imu=/sensing/imu", "--topic", "gear=/vehicle/gear"],
+                       capture_output=True, text=True, timeout=120)
+    assert r.returncode == 2 and "no field 'steering'" in r.stderr and "column 21" in r.stderr, r.stderr
