@@ -1,5 +1,6 @@
 """Timing atoms and aggregates on the command line: spec errors name the column (exit 2), and a
 JSON-lines file with a gap is checked like the bag (tests/cli/test_timed_bag.py), hand-computed."""
+import json
 import subprocess
 
 
@@ -43,3 +44,15 @@ def test_a_gap_in_a_file_is_reported_where_it_starts(rvc, tmp_path):
     # discrete: sum of x over the last two steps (steps t-1, t), x = 0, 1, 2, ...
     r = run(rvc, "check", "--all", "--spec", "{sum[0:1](x) >= 5}", str(trace))
     assert [line.endswith("true}") for line in r.stdout.splitlines()] == [False, False, False, True, True, True, True]
+
+
+def test_robustness_of_aggregates_is_value_minus_threshold(rvc, tmp_path):
+    trace = tmp_path / "t.jsonl"
+    trace.write_text("".join(f'{{"time": {t}, "x": {i}}}\n' for i, t in enumerate([0, 0.25, 0.5, 1.5])))
+    # discrete: sum of the last two steps' x (0, 1, 3, 5) minus 5
+    r = run(rvc, "check", "--robustness", "--all", "--spec", "{sum[0:1](x) >= 5}", str(trace))
+    assert [json.loads(line)["value"] for line in r.stdout.splitlines()] == [-5, -4, -2, 0], r.stderr
+    # dense: max over (t-0.5, t]: 0 on [0,0.25), 1 on [0.25,0.5), 2 on [0.5,1), empty on [1,1.5): -inf
+    r = run(rvc, "check", "--robustness", "--dense", "--spec", "{max[0:0.5](x) > 1}", str(trace))
+    assert [(json.loads(line)["time"], json.loads(line)["value"]) for line in r.stdout.splitlines()] == \
+        [(0, -1), (0.25, 0), (0.5, 1), (1, "-inf")], r.stdout
