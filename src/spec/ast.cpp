@@ -96,11 +96,14 @@ std::string FieldTest::timed_input() const {
 }
 
 std::string FieldTest::key() const {
+  // The last part is a timing atom's name (bare), unless this is an
+  // aggregate of a field, whose key may be "@x" like any other (quoted).
+  const bool names_atom = is_timed() && (timed.kind != Timed::Kind::Aggregate || timed.of_arrivals);
   std::string out;
   for (size_t i = 0; i < path.size(); ++i) {
     if (is_index_part(path[i])) out += path[i];
     // A timing atom's name is written bare; a field named "@age" is quoted.
-    else if (is_timed() && i + 1 == path.size() && !path[i].empty() && path[i][0] == '@') out += (i ? "." : "") + path[i];
+    else if (i + 1 == path.size() && names_atom) out += (i ? "." : "") + path[i];
     else out += (i ? "." : "") + quote_if_needed(path[i]);
   }
   return out;

@@ -147,6 +147,8 @@ TEST(TimedSyntax, PrintsAndReparses) {
   EXPECT_EQ(canonical("{count[2] > 3}"), "{count[2] > 3}");
   // A field whose key is "@age" is quoted, and is no timing atom.
   EXPECT_EQ(canonical("{\"@age\" > 3}"), "{\"@age\" > 3}");
+  EXPECT_EQ(canonical("{avg(\"@x\") > 3}"), "{avg(\"@x\") > 3}");
+  EXPECT_EQ(canonical("{\"@age\".@age > 3}"), "{\"@age\".@age > 3}");
 }
 
 TEST(TimedSyntax, ErrorsPointAtTheColumn) {
