@@ -103,8 +103,8 @@ std::string FieldTest::key() const {
   for (size_t i = 0; i < path.size(); ++i) {
     if (is_index_part(path[i])) out += path[i];
     // A timing atom's name is written bare; a field named "@age" is quoted.
-    else if (i + 1 == path.size() && names_atom) out += (i ? "." : "") + path[i];
-    else out += (i ? "." : "") + quote_if_needed(path[i]);
+    else if (i + 1 == path.size() && names_atom) out.append(i ? "." : "").append(path[i]);
+    else out.append(i ? "." : "").append(quote_if_needed(path[i]));
   }
   return out;
 }
