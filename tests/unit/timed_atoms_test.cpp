@@ -303,6 +303,19 @@ TEST(TimedSynced, AnInputArrivesInTheSetThatUsesItsMessage) {
   EXPECT_EQ(v, (Verdicts{{0, true}, {1, false}, {2, false}, {3, true}, {4, true}}));
 }
 
+TEST(TimedSynced, InputsWithEqualStampsArriveInTheSameSet) {
+  // merge makes one set per stamp: imu and odo both at 1 -> both arrive there; discrete @age counts sets.
+  const Verdicts v = run_synced("{imu.@arrived} and {odo.@arrived}", false,
+                                {{0, 0, R"({"time": 0})"}, {1, 0, R"({"time": 1})"}, {0, 0, R"({"time": 1})"},
+                                 {1, 0, R"({"time": 2})"}});
+  EXPECT_EQ(v, (Verdicts{{0, false}, {1, true}, {2, false}}));
+  const Verdicts age = run_synced("{imu.@age >= 1}", false,
+                                  {{0, 0, R"({"time": 0})"}, {1, 0, R"({"time": 1})"}, {1, 0, R"({"time": 2})"},
+                                   {0, 0, R"({"time": 3})"}});
+  // sets: imu@0 (age 0), odo@1 (1), odo@2 (2), imu@3 (0)
+  EXPECT_EQ(age, (Verdicts{{0, false}, {1, true}, {2, true}, {3, false}}));
+}
+
 TEST(TimedSynced, AGapInOneInputIsFoundBetweenTheOthersMessages) {
   std::vector<std::tuple<uint32_t, double, std::string>> m;
   for (double t : {0.0, 0.1, 0.2, 0.6, 0.7}) m.emplace_back(0, t, "{\"time\": " + std::to_string(t) + "}");
