@@ -29,6 +29,7 @@ void Checker::enable_explain() {
 void Checker::add_property(const PropertySpec& property) {
   spec::ParseOptions options;
   options.dense = model_ == TimeModel::Dense;
+  options.robustness = robustness_;
   spec::NodePtr ast = spec::parse(property.spec, options);
   Program program = compile(*ast, atoms_, model_, property.spec);
   if (program.has_data()) {

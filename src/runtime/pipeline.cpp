@@ -1,5 +1,7 @@
 #include "runtime/pipeline.hpp"
 
+#include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <limits>
 #include <stdexcept>
@@ -7,10 +9,36 @@
 #include "io/cdr_codec.hpp"
 #include "io/verdict_writer.hpp"
 #include "runtime/typed_specs.hpp"
+#include "spec/parser.hpp"
 #include "spec/spec_error.hpp"
 
 namespace rvc::runtime {
 namespace {
+
+// One unnamed input: {steer.@age ..} names an input there is not.
+void check_unnamed(const std::vector<engine::PropertySpec>& properties, const PipelineOptions& options) {
+  spec::ParseOptions po;
+  po.dense = options.model == engine::TimeModel::Dense;
+  po.robustness = options.robustness;
+  for (const auto& p : properties) {
+    const spec::NodePtr ast = spec::parse(p.spec, po);
+    std::vector<const spec::Node*> todo{ast.get()};
+    while (!todo.empty()) {
+      const spec::Node* n = todo.back();
+      todo.pop_back();
+      if (n->left) todo.push_back(n->left.get());
+      if (n->right) todo.push_back(n->right.get());
+      const spec::FieldTest& t = n->test;
+      if (n->op != spec::Op::Test || !t.is_timed() || t.timed.kind == spec::Timed::Kind::Aggregate ||
+          t.path.size() < 2)
+        continue;
+      throw spec::SpecError("in property '" + p.name + "': '" + t.path[0] + "." + t.path[1] +
+                                "' names an input, and this run has one unnamed input: write {" + t.path[1] +
+                                " ...} (named inputs come with several --input NAME=URI or --topic NAME=TOPIC)",
+                            p.spec, t.column);
+    }
+  }
+}
 
 engine::Checker build(const std::vector<engine::PropertySpec>& properties, const PipelineOptions& options,
                       engine::VerdictCallback on_verdict) {
@@ -25,6 +53,7 @@ engine::Checker build(const std::vector<engine::PropertySpec>& properties, const
       throw spec::SpecError("in property '" + p.name + "': " + e.message(), e.source(), e.column());
     }
   }
+  check_unnamed(properties, options);
   if (options.type)
     bind_message_type(checker, properties, *options.type, options.model == engine::TimeModel::Dense,
                       options.time_field);
@@ -45,18 +74,35 @@ std::string number(double v) {
   return s;
 }
 
+// The run's timing atoms and aggregates, or null when its properties have none.
+std::unique_ptr<engine::timed::TimedAtoms> make_timed(engine::Checker& checker) {
+  bool any = false;
+  for (const auto& t : checker.atoms().tests()) any = any || t.is_timed();
+  if (!any) return nullptr;
+  return std::make_unique<engine::timed::TimedAtoms>(checker.atoms(), std::vector<std::string>{""}, checker.model());
+}
+
+bool needs_margins(const PipelineOptions& o, const engine::timed::TimedAtoms* timed) {
+  return o.robustness || (timed && timed->needs_field_values());
+}
+
 }  // namespace
 
 Pipeline::Pipeline(const std::vector<engine::PropertySpec>& properties, const PipelineOptions& options,
                    engine::VerdictCallback on_verdict)
     : checker_(build(properties, with_defaults(options), std::move(on_verdict))),
+      timed_(make_timed(checker_)),
       options_(with_defaults(options)),
       atoms_(checker_.atoms()),
       decoder_(atoms_, io::DecoderOptions{options.model == engine::TimeModel::Dense, options.time_field,
-                                          options.strict, options.robustness, options.layouts}),
+                                          options.strict, needs_margins(options, timed_.get()), options.layouts}),
       batch_reader_(*this, options.max_message_size) {
   make_typed_decoder();
-  fast_commit_ = !typed_ && !options_.on_message && !options_.parse_only && !options_.robustness &&
+  if (timed_) {
+    timed_values_.assign(atoms_.size(), 0);
+    timed_margins_.assign(atoms_.size(), -std::numeric_limits<double>::infinity());
+  }
+  fast_commit_ = !timed_ && !typed_ && !options_.on_message && !options_.parse_only && !options_.robustness &&
                  options_.model == engine::TimeModel::Discrete;
   // --explain names the values a data reference decided on by their JSON
   // text; the decoders assign their ids. (A Pipeline never moves: its
@@ -71,7 +117,7 @@ void Pipeline::make_typed_decoder() {
   if (!options_.type) return;
   typed_.emplace(atoms_, *options_.type,
                  io::DecoderOptions{options_.model == engine::TimeModel::Dense, options_.time_field, options_.strict,
-                                    options_.robustness});
+                                    needs_margins(options_, timed_.get())});
 }
 
 Pipeline::Pipeline(const engine::AtomTable& atoms, const PipelineOptions& options, MessageHook hook)
@@ -80,7 +126,7 @@ Pipeline::Pipeline(const engine::AtomTable& atoms, const PipelineOptions& option
       atoms_(atoms),
       hook_(std::move(hook)),
       decoder_(atoms_, io::DecoderOptions{options.model == engine::TimeModel::Dense, options.time_field,
-                                          options.strict, false, options.layouts}),
+                                          options.strict, options.robustness, options.layouts}),
       batch_reader_(*this, options.max_message_size) {
   make_typed_decoder();
 }
@@ -182,10 +228,12 @@ void Pipeline::commit() {
     commit_values();
   } else if (checker_.robustness() && checker_.model() == engine::TimeModel::Discrete) {
     commit_values();
-    checker_.step_robust(margins());
+    arrive_timed(static_cast<double>(steps_++));
+    checker_.step_robust(held_margins());
   } else if (checker_.model() == engine::TimeModel::Discrete) {
     commit_values();
-    step_checker(*pending_where_, [&] { checker_.step(values(), bound()); });
+    arrive_timed(static_cast<double>(steps_++));
+    step_checker(*pending_where_, [&] { checker_.step(held_values(), bound()); });
   } else {
     // Dense: this message closes [previous time, its time) with the previous values.
     double t = message_time();
@@ -197,9 +245,17 @@ void Pipeline::commit() {
       on_error(io::LineError{pending_where_->number(), 0, why});
       return;
     }
-    if (checker_.robustness()) checker_.step_robust(begin, t, margins());
-    else step_checker(*pending_where_, [&] { checker_.step(begin, t, values(), bound()); });
+    // Timed atoms that change before t: the monitors step to each change
+    // with the values before it (a gap in a recording needs no clock).
+    for (double c; (c = timed_next_change()) < t; begin = c) {
+      if (checker_.robustness()) checker_.step_robust(begin, c, held_margins());
+      else step_checker(*pending_where_, [&] { checker_.step(begin, c, held_values(), bound()); });
+      advance_timed(c);
+    }
+    if (checker_.robustness()) checker_.step_robust(begin, t, held_margins());
+    else step_checker(*pending_where_, [&] { checker_.step(begin, t, held_values(), bound()); });
     commit_values();
+    arrive_timed(t);
     has_time_ = true;
     last_time_ = t;
   }
@@ -207,6 +263,44 @@ void Pipeline::commit() {
   stats_.by_layout += pending_matched_;
   // A message simdjson read teaches its layout, so the next ones like it are read by position.
   if (!pending_matched_ && !typed_ && decoder_.wants_layout()) decoder_.learn(pending_where_->text());
+}
+
+void Pipeline::advance_timed(double t) {
+  if (timed_) timed_->advance(t);
+}
+
+// The committed message arrived at t (a step, or its time in dense time).
+void Pipeline::arrive_timed(double t) {
+  if (!timed_) return;
+  timed_->advance(t);
+  const double latency = arrival_ - t;  // NaN without an arrival (a file's lines)
+  timed_->arrive(0, latency, values(), margins());
+}
+
+const uint8_t* Pipeline::held_values() {
+  if (!timed_) return values();
+  std::copy(values(), values() + atoms_.size(), timed_values_.begin());
+  timed_->write(timed_values_.data());
+  return timed_values_.data();
+}
+
+const double* Pipeline::held_margins() {
+  if (!timed_) return margins();
+  std::copy(margins(), margins() + atoms_.size(), timed_margins_.begin());
+  timed_->write_margins(timed_margins_.data());
+  return timed_margins_.data();
+}
+
+void Pipeline::feed_input(uint32_t, std::string_view payload, uint64_t position) {
+  // Live: a message's arrival is now (wall clock), read only when a property asks.
+  if (timed_ && timed_->needs_arrival())
+    arrival_ = std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+  feed(payload, position);
+}
+
+void Pipeline::feed_logged(uint32_t, std::string_view payload, uint64_t position, double log_time) {
+  arrival_ = log_time;
+  feed(payload, position);
 }
 
 bool Pipeline::oversized(std::string_view payload, uint64_t position) {

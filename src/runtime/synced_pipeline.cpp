@@ -42,7 +42,9 @@ struct SyncedPipeline::Held {
   bool used = false;
   double stamp = 0;       // its own stamp (a late message checked with --late process goes out later)
   uint64_t position = 0;  // its line or sequence number, for messages about it
+  double arrival = 0;     // when rvc received it ({input.@latency})
   std::vector<uint8_t> values;  // in the input's atom order
+  std::vector<double> margins;  // likewise, when field aggregates read them
   std::string text;             // as JSON, only when sets are published
 };
 
@@ -83,6 +85,11 @@ void check_paths(const std::vector<engine::PropertySpec>& properties, const std:
   for (const auto& p : properties) {
     spec::NodePtr ast = spec::parse(p.spec, options);
     std::function<void(const spec::Node&)> walk = [&](const spec::Node& n) {
+      if (n.op == spec::Op::Test && n.test.is_timed() && n.test.timed.kind != spec::Timed::Kind::Aggregate &&
+          n.test.path.size() == 1)
+        throw spec::SpecError("in property '" + p.name + "': with several inputs, say whose " + n.test.path[0] +
+                                  " it is: {input." + n.test.path[0] + " ...} (inputs: " + names_of(inputs) + ")",
+                              p.spec, n.test.column);
       if (n.op == spec::Op::Test) {
         const auto& path = n.test.path;
         bool known = false;
@@ -142,6 +149,13 @@ SyncedPipeline::SyncedPipeline(const std::vector<engine::PropertySpec>& properti
   if (checker_.has_data_references())
     throw std::invalid_argument("data references (exists/forall) check one input for now (not several synchronized ones)");
   check_paths(properties, inputs, dense);
+  bool timed = false;
+  for (const auto& t : checker_.atoms().tests()) timed = timed || t.is_timed();
+  if (timed) {  // before the inputs' tables: field aggregates add tests
+    std::vector<std::string> names;
+    for (const auto& i : inputs) names.push_back(i.name);
+    timed_ = std::make_unique<engine::timed::TimedAtoms>(checker_.atoms(), names, options.model);
+  }
 
   inputs_.resize(inputs.size());
   for (size_t k = 0; k < inputs.size(); ++k) {
@@ -150,7 +164,7 @@ SyncedPipeline::SyncedPipeline(const std::vector<engine::PropertySpec>& properti
     // The input's tests, as its decoder sees them.
     const auto& tests = checker_.atoms().tests();
     for (size_t id = 0; id < tests.size(); ++id) {
-      if (tests[id].path[0] != in.spec.name) continue;
+      if (tests[id].is_timed() || tests[id].path[0] != in.spec.name) continue;
       spec::FieldTest local = tests[id];
       local.path.erase(local.path.begin());
       in.slots.emplace_back(static_cast<int>(id), in.atoms->intern(local));
@@ -173,6 +187,7 @@ SyncedPipeline::SyncedPipeline(const std::vector<engine::PropertySpec>& properti
     po.position_name = "input " + in.spec.name + " " + options.position_name;
     in.position_name = po.position_name;
     po.input_name = in.spec.name;
+    po.robustness = timed_ && timed_->needs_field_values();  // margins: the fields' values
     if (in.spec.type) bind_message_type(*in.atoms, properties, *in.spec.type, dense, po.time_field, in.spec.name);
     const auto input = static_cast<uint32_t>(k);
     in.pipeline = std::make_unique<Pipeline>(
@@ -181,6 +196,10 @@ SyncedPipeline::SyncedPipeline(const std::vector<engine::PropertySpec>& properti
         });
   }
   combined_.assign(checker_.atoms().size(), 0);
+  if (timed_) {
+    combined_margins_.assign(checker_.atoms().size(), -std::numeric_limits<double>::infinity());
+    timed_->write(combined_.data());
+  }
   sync::PolicyOptions po = sync.policy_options;
   po.inputs = inputs_.size();
   policy_ = sync::make_policy(sync.policy, po, *this);
@@ -259,7 +278,10 @@ void SyncedPipeline::accept(uint32_t input, const uint8_t* values, double time, 
   h.used = false;
   h.stamp = stamp;
   h.position = position;
+  h.arrival = arrival_;
   h.values.assign(values, values + in.atoms->size());
+  if (timed_ && timed_->needs_field_values())
+    h.margins.assign(in.pipeline->committed_margins(), in.pipeline->committed_margins() + in.atoms->size());
   h.text.clear();
   if (on_set_) {
     if (in.spec.type) {
@@ -353,9 +375,18 @@ void SyncedPipeline::on_set(const sync::Member* members, size_t count, double se
              std::to_string(last_time_) + " (dense time needs strictly increasing times; set skipped)");
       return;
     }
-    // The set closes [previous time, its time) with the previous values.
-    if (!options_.parse_only) checker_.step(has_time_ ? last_time_ : 0, set_stamp, combined_.data());
+    // The set closes [previous time, its time) with the previous values,
+    // stepping first through the instants where timed atoms change.
+    double begin = has_time_ ? last_time_ : 0;
+    if (!options_.parse_only) {
+      for (double c; (c = timed_next_change()) < set_stamp; begin = c) {
+        checker_.step(begin, c, held_values());
+        advance_timed(c);
+      }
+      checker_.step(begin, set_stamp, held_values());
+    }
   }
+  if (timed_) timed_->advance(options_.model == engine::TimeModel::Dense ? set_stamp : static_cast<double>(sets_));
   for (size_t m = 0; m < count; ++m) {
     Held& h = held_[members[m].token];
     Input& in = inputs_[members[m].input];
@@ -365,13 +396,19 @@ void SyncedPipeline::on_set(const sync::Member* members, size_t count, double se
       report_late(members[m], has_time_ ? last_time_ : set_stamp, true, false);
     }
     for (const auto& [global, local] : in.slots) combined_[global] = h.values[local];
+    if (!h.margins.empty())
+      for (const auto& [global, local] : in.slots) combined_margins_[global] = h.margins[local];
     if (!h.used) {
       h.used = true;
       ++in.counters.used;
+      // Its first set: the input arrives ({in.@arrived}, its age restarts, a sample).
+      if (timed_)
+        timed_->arrive(members[m].input, in.arrival_stamp ? 0 : h.arrival - h.stamp, combined_.data(),
+                       combined_margins_.empty() ? nullptr : combined_margins_.data());
     }
     if (on_set_) in.last_text = h.text;
   }
-  if (options_.model == engine::TimeModel::Discrete && !options_.parse_only) checker_.step(combined_.data());
+  if (options_.model == engine::TimeModel::Discrete && !options_.parse_only) checker_.step(held_values());
   has_time_ = true;
   last_time_ = set_stamp;
   ++sets_;
@@ -383,6 +420,15 @@ void SyncedPipeline::on_set(const sync::Member* members, size_t count, double se
     json_ = set.str();
     on_set_(json_, set_stamp);
   }
+}
+
+void SyncedPipeline::advance_timed(double t) {
+  if (timed_) timed_->advance(t);
+}
+
+const uint8_t* SyncedPipeline::held_values() {
+  if (timed_) timed_->write(combined_.data());  // the timed atoms' own slots: no input writes them
+  return combined_.data();
 }
 
 void SyncedPipeline::on_release(const sync::Member& message, sync::Release why) {

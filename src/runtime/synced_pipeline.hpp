@@ -14,12 +14,14 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "engine/checker.hpp"
+#include "engine/timed/timed_atoms.hpp"
 #include "msg/msg_types.hpp"
 #include "runtime/feed.hpp"
 #include "runtime/pipeline.hpp"
@@ -90,6 +92,15 @@ class SyncedPipeline final : public Feed, private sync::Handler {
   // bags (whose arrival is the log time).
   void feed_at(uint32_t input, std::string_view payload, uint64_t position, double arrival);
   const engine::Checker& checker() const { return checker_; }
+
+  // Timing atoms and aggregates ({steer.@age <= 0.1}, count[0:1](steer.@arrived)),
+  // as Pipeline has them: an input "arrives" in a set when one of its
+  // messages is used for the first time in that set. Files and bags step
+  // through their change instants between sets (on_set); a live clock uses:
+  double timed_next_change() const { return timed_ ? timed_->next_change() : std::numeric_limits<double>::infinity(); }
+  void advance_timed(double t);
+  // The combined values the monitors hold since the last set, timed atoms included.
+  const uint8_t* held_values();
   uint64_t sets() const { return sets_; }
   size_t inputs() const;
 
@@ -116,6 +127,8 @@ class SyncedPipeline final : public Feed, private sync::Handler {
   void report_late(const sync::Member& message, double after, bool checked, bool replaced);
 
   engine::Checker checker_;
+  std::unique_ptr<engine::timed::TimedAtoms> timed_;  // null: no timing atoms
+  std::vector<double> combined_margins_;  // field aggregates: the members' margins (their field values)
   PipelineOptions options_;
   SyncOptions sync_;
   std::vector<Input> inputs_;

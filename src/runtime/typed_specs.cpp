@@ -110,6 +110,16 @@ void bind_message_type(engine::AtomTable& atoms, const std::vector<engine::Prope
       std::function<void(const spec::Node&)> walk = [&](const spec::Node& n) {
         if (n.op == spec::Op::Test) {
           spec::FieldTest test = n.test;
+          if (test.is_timed()) {
+            // A timing atom reads no field; an aggregate's field must exist.
+            if (test.timed.kind != spec::Timed::Kind::Aggregate || test.timed.of_arrivals) test.path.clear();
+            test.timed = {};
+            test.op = spec::FieldTest::Op::Truthy;
+          }
+          if (test.path.empty()) {
+            if (n.left) walk(*n.left);
+            return;
+          }
           // One input of several: its tests, seen as the input sees them.
           const bool mine = input.empty() || (test.path.size() > 1 && test.path[0] == input);
           if (!input.empty() && mine) test.path.erase(test.path.begin());

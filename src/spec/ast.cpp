@@ -70,17 +70,48 @@ uint32_t index_of_part(const std::string& part) {
   return static_cast<uint32_t>(std::stoul(part.substr(1, part.size() - 2)));
 }
 
+const char* timed_name(Timed::Kind kind) {
+  switch (kind) {
+    case Timed::Kind::Arrived: return "@arrived";
+    case Timed::Kind::Age: return "@age";
+    case Timed::Kind::Latency: return "@latency";
+    default: return "";
+  }
+}
+
+const char* func_name(Timed::Func func) {
+  switch (func) {
+    case Timed::Func::Count: return "count";
+    case Timed::Func::Sum: return "sum";
+    case Timed::Func::Avg: return "avg";
+    case Timed::Func::Min: return "min";
+    case Timed::Func::Max: return "max";
+  }
+  return "?";
+}
+
+std::string FieldTest::timed_input() const {
+  if (!is_timed() || path.size() < 2) return "";
+  return path[0];
+}
+
 std::string FieldTest::key() const {
+  // The last part is a timing atom's name (bare), unless this is an
+  // aggregate of a field, whose key may be "@x" like any other (quoted).
+  const bool names_atom = is_timed() && (timed.kind != Timed::Kind::Aggregate || timed.of_arrivals);
   std::string out;
   for (size_t i = 0; i < path.size(); ++i) {
     if (is_index_part(path[i])) out += path[i];
-    else out += (i ? "." : "") + quote_if_needed(path[i]);
+    // A timing atom's name is written bare; a field named "@age" is quoted.
+    else if (i + 1 == path.size() && names_atom) out.append(i ? "." : "").append(path[i]);
+    else out.append(i ? "." : "").append(quote_if_needed(path[i]));
   }
   return out;
 }
 
 std::string FieldTest::to_string() const {
   std::string k = key();
+  if (timed.kind == Timed::Kind::Aggregate) k = std::string(func_name(timed.func)) + bounds_text(timed.window) + "(" + k + ")";
   switch (op) {
     case Op::Truthy: return k;
     case Op::Present: return k + ": *";

@@ -38,7 +38,27 @@ struct Literal {
 bool is_index_part(const std::string& part);
 uint32_t index_of_part(const std::string& part);  // "[12]" -> 12
 
+// A timing atom or a window aggregate (issue 26): not a field of the message
+// but what the runtime knows about an input's messages over time.
+//   {steer.@arrived}                 a message of input steer is in this step
+//   {steer.@age <= 0.1}              time since its last message
+//   {steer.@latency < 0.05}          arrival - stamp of its last message
+//   {count[0:1](steer.@arrived) >= 20}, {avg[0:2](steer.speed) > 3}
+// The input name is left out with one unnamed input ({@age <= 0.2}).
+struct Timed {
+  enum class Kind : uint8_t { None, Arrived, Age, Latency, Aggregate };
+  enum class Func : uint8_t { Count, Sum, Avg, Min, Max };
+  Kind kind = Kind::None;
+  Func func = Func::Count;  // Aggregate
+  Bounds window;            // Aggregate: the past window (steps, or seconds in dense time)
+  bool of_arrivals = false; // Aggregate over x.@arrived (each message counts 1), else over the field `path`
+};
+const char* timed_name(Timed::Kind kind);  // "@age"
+const char* func_name(Timed::Func func);   // "count"
+
 // One test on one field: {p}, {p: false}, {x > 3}, {mode: "a"}, {m: *}, {id: *x}.
+// Timing atoms and aggregates are tests too (see Timed): `path` names the
+// input then the atom ({"steer", "@age"}), or an aggregate's field.
 struct FieldTest {
   enum class Op { Truthy, Eq, Ne, Lt, Le, Gt, Ge, Present, Bind };
   // "a.b" -> {"a", "b"}; quoted keys stay whole; an array element is its own
@@ -48,7 +68,11 @@ struct FieldTest {
   Literal value;                  // for Eq .. Ge
   std::string variable;           // for Bind ({id: *x})
   int column = 0;
+  Timed timed;                    // kind None: an ordinary field test
 
+  bool is_timed() const { return timed.kind != Timed::Kind::None; }
+  // The input a timing atom or aggregate is about ("" with one unnamed input).
+  std::string timed_input() const;
   std::string key() const;        // path joined with '.'
   std::string to_string() const;  // canonical text, used to share atoms between properties
 };

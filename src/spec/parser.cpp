@@ -9,7 +9,9 @@
 #include <cmath>
 #include <cstdint>
 #include <exception>
+#include <string>
 #include <system_error>
+#include <utility>
 #include <vector>
 
 namespace rvc::spec {
@@ -429,17 +431,109 @@ class Parser {
     return out;
   }
 
+  // An aggregate's name followed by its window or its '(': count[0:1](..),
+  // sum(..). A field may be named "count": {count > 3}, {count[2] > 3} (an
+  // array element: no ':' inside the brackets) stay field tests.
+  bool peek_aggregate(Timed::Func& func, size_t& length) const {
+    static constexpr std::pair<const char*, Timed::Func> kFuncs[] = {
+        {"count", Timed::Func::Count}, {"sum", Timed::Func::Sum}, {"avg", Timed::Func::Avg},
+        {"min", Timed::Func::Min},     {"max", Timed::Func::Max}};
+    for (const auto& [word, f] : kFuncs) {
+      const size_t n = std::char_traits<char>::length(word);
+      if (s_.compare(pos_, n, word) != 0 || pos_ + n >= s_.size()) continue;
+      const char next = s_[pos_ + n];
+      bool window = false;
+      if (next == '[') {
+        // Scans only to the first ':' or ']', which the parse then consumes either way.
+        const size_t first = s_.find_first_of(":]", pos_ + n);
+        window = first != std::string::npos && s_[first] == ':';
+      }
+      if (next == '(' || window) {
+        func = f;
+        length = n;
+        return true;
+      }
+    }
+    return false;
+  }
+
+  // A field path, or an input's timing atom as its last part: {@age ..},
+  // {steer.@age ..}. Returns where the timing atom was written (npos: none).
+  size_t parse_path(FieldTest& t) {
+    for (;;) {
+      skip_ws();
+      if (peek() == '@') {
+        const size_t at = pos_++;
+        while (is_ident_char(peek())) ++pos_;
+        const std::string name = s_.substr(at, pos_ - at);
+        if (name == "@arrived") t.timed.kind = Timed::Kind::Arrived;
+        else if (name == "@age") t.timed.kind = Timed::Kind::Age;
+        else if (name == "@latency") t.timed.kind = Timed::Kind::Latency;
+        else fail("unknown timing atom '" + name + "': there are @arrived, @age and @latency", at);
+        if (t.path.size() > 1 || (t.path.size() == 1 && is_index_part(t.path[0])))
+          fail("'" + name + "' follows an input's name ({steer." + name.substr(1) + "}), not a field", at);
+        t.path.push_back(name);
+        if (peek() == '.' || peek() == '[') fail("'" + name + "' ends the path: nothing can follow it", pos_);
+        return at;
+      }
+      t.path.push_back(parse_key_segment());
+      parse_indexes(t.path);
+      if (peek() != '.') return std::string::npos;  // nested field: {pose.position.x > 1}
+      ++pos_;
+    }
+  }
+
+  // The comparison a timing atom or an aggregate needs: {x.@age <= 0.1}.
+  void parse_number_comparison(FieldTest& t, const std::string& what, const std::string& example) {
+    skip_ws();
+    const size_t op_at = pos_;
+    using FOp = FieldTest::Op;
+    if (accept_symbol("==")) t.op = FOp::Eq;
+    else if (accept_symbol("!=")) t.op = FOp::Ne;
+    else if (accept_symbol("<=")) t.op = FOp::Le;
+    else if (accept_symbol(">=")) t.op = FOp::Ge;
+    else if (accept_symbol("<")) t.op = FOp::Lt;
+    else if (accept_symbol(">")) t.op = FOp::Gt;
+    else fail(what + " is a number: compare it (< <= > >= == !=) with one, e.g. " + example, op_at);
+    skip_ws();
+    const size_t lit_at = pos_;
+    t.value = parse_literal(/*allow_bare_word=*/false);
+    if (t.value.kind != Literal::Kind::Number) fail(what + " is compared with a number; this is not a number", lit_at);
+  }
+
+  // {count[0:1](steer.@arrived) >= 20}, {avg[0:2](steer.speed) > 3}
+  FieldTest parse_aggregate(FieldTest t, Timed::Func func, size_t length) {
+    const size_t at = pos_;
+    const std::string name = s_.substr(pos_, length);
+    pos_ += length;
+    t.timed.func = func;
+    t.timed.window = parse_bounds_opt(at);
+    expect("(", "after '" + name + "[a:b]' to name what it aggregates, e.g. count[0:1](x.@arrived), avg[0:2](x.speed)");
+    skip_ws();
+    const size_t inner_at = pos_;
+    const size_t atom_at = parse_path(t);
+    if (t.timed.kind == Timed::Kind::Age || t.timed.kind == Timed::Kind::Latency)
+      fail(name + " aggregates a field or arrivals (x.@arrived), not " + std::string(timed_name(t.timed.kind)), atom_at);
+    t.timed.of_arrivals = t.timed.kind == Timed::Kind::Arrived;
+    if (t.timed.of_arrivals && func != Timed::Func::Count)
+      fail("arrivals are counted: count[a:b](x.@arrived); " + name + " takes a numeric field", inner_at);
+    skip_ws();
+    if (peek() != ')') fail("expected ')' to close " + name + "(", pos_);
+    ++pos_;
+    t.timed.kind = Timed::Kind::Aggregate;
+    parse_number_comparison(t, "an aggregate", "{" + name + "[0:1](x.speed) > 3}");
+    return t;
+  }
+
   FieldTest parse_field_test() {
     FieldTest t;
     skip_ws();
     t.column = column(pos_);
-    t.path.push_back(parse_key_segment());
-    parse_indexes(t.path);
-    while (peek() == '.') {  // nested field: {pose.position.x > 1}
-      ++pos_;
-      t.path.push_back(parse_key_segment());
-      parse_indexes(t.path);
-    }
+    Timed::Func func;
+    size_t length = 0;
+    if (peek_aggregate(func, length)) return parse_aggregate(std::move(t), func, length);
+    const size_t atom_at = parse_path(t);
+    if (t.is_timed()) return finish_timing_atom(std::move(t), atom_at);
     skip_ws();
     size_t op_at = pos_;
     using FOp = FieldTest::Op;
@@ -476,6 +570,29 @@ class Parser {
     bool ordering = t.op == FOp::Lt || t.op == FOp::Le || t.op == FOp::Gt || t.op == FOp::Ge;
     if (ordering && t.value.kind != Literal::Kind::Number)
       fail("'<', '<=', '>', '>=' compare numbers; this is not a number", lit_at);
+    return t;
+  }
+
+  // {x.@arrived} alone; {x.@age <= d} and {x.@latency < d} compare.
+  FieldTest finish_timing_atom(FieldTest t, size_t atom_at) {
+    skip_ws();
+    if (t.timed.kind == Timed::Kind::Arrived) {
+      if (opt_.dense)
+        fail("in dense time an arrival is an instant and holds no value over time: write {x.@age <= d} for "
+             "silence or count[a:b](x.@arrived) for a rate",
+             atom_at);
+      if (peek() != ',' && peek() != '}')
+        fail("@arrived is true or false: write {x.@arrived} or not {x.@arrived}", pos_);
+      return t;
+    }
+    if (t.timed.kind == Timed::Kind::Latency && !opt_.dense)
+      fail("@latency compares a message's arrival with its stamp: it needs dense time (--dense)", atom_at);
+    if (t.timed.kind == Timed::Kind::Age && opt_.dense && opt_.robustness)
+      fail("@age grows continuously in dense time, so its margin is no step function: check it without "
+           "--robustness (or in discrete time, where it counts steps)",
+           atom_at);
+    const std::string name = timed_name(t.timed.kind);
+    parse_number_comparison(t, name, "{x." + name.substr(0) + " <= 0.1}");
     return t;
   }
 

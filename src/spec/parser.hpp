@@ -19,6 +19,7 @@ namespace rvc::spec {
 
 struct ParseOptions {
   bool dense = false;  // dense time accepts real-valued bounds; discrete needs integers
+  bool robustness = false;  // --robustness: refuses what has no piecewise-constant margin (dense @age)
 };
 
 // Throws SpecError (with the column) on any problem; never returns null.
