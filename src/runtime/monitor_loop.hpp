@@ -18,6 +18,7 @@
 #include "runtime/exit_status.hpp"
 #include "runtime/feed.hpp"
 #include "runtime/message_filter.hpp"
+#include "runtime/stream_clock.hpp"
 #include "runtime/verdict_outputs.hpp"
 #include "transport/endpoint.hpp"
 #include "transport/seq_counter.hpp"
@@ -47,6 +48,15 @@ struct LoopOptions {
   // for the results store (apart from stats_interval, which prints them).
   std::function<void(const std::string&)> on_record;
   double record_interval = 1;
+  // Dense time on a clock (--clock, --tick; docs/semantics.md "Ticks"): while
+  // no message comes, the loop sleeps until the feed's next deadline on
+  // this clock and ticks there. Off: the monitors move only with messages.
+  ClockKind clock = ClockKind::Off;
+  double tick_bound = 0;  // --tick: at most this many seconds between ticks (0: deadlines only)
+  // A file input: at its end, a tick at its last stamp reports the last
+  // message's own verdicts (as `rvc check` does).
+  bool tick_at_end = false;
+  TimeSource time = TimeSource::system();
   std::function<bool()> stop_requested = [] { return false; };   // e.g. SIGINT/SIGTERM seen
   std::function<bool()> stats_requested = [] { return false; };  // e.g. SIGUSR1 seen (true once)
 };
@@ -76,6 +86,7 @@ class MonitorLoop {
   std::string stats_json() const;
   const transport::SeqCounters& counters(size_t input = 0) const { return counters_[input]; }
   EndReason end_reason() const { return end_; }
+  uint64_t ticks() const { return ticks_; }
   // The counters printed at the end of run().
   const std::string& final_stats() const { return final_stats_; }
 
@@ -88,6 +99,16 @@ class MonitorLoop {
   void handle(const transport::Frame& frame);  // one frame of either path
   // Counters on request or on schedule; false once the run should end.
   void on_schedule(std::chrono::steady_clock::time_point now);
+  // The clock: after a batch (the feed's newest stamp) and on every wake-up.
+  void follow_stamps(std::chrono::steady_clock::time_point now);
+  // Ticks at every deadline the clock has reached (and at --tick's bound);
+  // returns when the next tick is due (steady max: none).
+  std::chrono::steady_clock::time_point run_ticks(std::chrono::steady_clock::time_point now);
+  // The first of the scheduled duties (counters, record, idle timeout) and
+  // the next tick: how long the loop may sleep when no message comes.
+  std::chrono::steady_clock::time_point wake_at(std::chrono::steady_clock::time_point now,
+                                                std::chrono::steady_clock::time_point next_tick,
+                                                std::chrono::steady_clock::time_point last_message) const;
   bool ended() const;  // every input's publishers sent their end-of-stream markers
   uint64_t total(uint64_t transport::SeqCounters::*field) const;
 
@@ -103,6 +124,11 @@ class MonitorLoop {
   uint64_t filtered_ = 0;   // messages the filter kept from the monitor
   std::string projected_;   // the message as the filter projected it
   std::chrono::steady_clock::time_point last_stats_{}, last_record_{};
+  StreamClock clock_{ClockKind::Off};
+  double clock_stamp_ = 0;  // the feed's stamp the clock was last set from
+  bool clock_said_ = false;
+  uint64_t ticks_ = 0;      // ticks made (each at a deadline or at --tick's bound)
+  std::chrono::steady_clock::time_point last_tick_{};
   double first_at_ = 0;  // wall clock of the first message (benchmarks compare across processes)
 };
 

@@ -197,6 +197,7 @@ void Pipeline::commit() {
       on_error(io::LineError{pending_where_->number(), 0, why});
       return;
     }
+    if (t <= checker_.clock() && checker_.clock() > last_time_) note_late(t);
     if (checker_.robustness()) checker_.step_robust(begin, t, margins());
     else step_checker(*pending_where_, [&] { checker_.step(begin, t, values(), bound()); });
     commit_values();
@@ -207,6 +208,36 @@ void Pipeline::commit() {
   stats_.by_layout += pending_matched_;
   // A message simdjson read teaches its layout, so the next ones like it are read by position.
   if (!pending_matched_ && !typed_ && decoder_.wants_layout()) decoder_.learn(pending_where_->text());
+}
+
+void Pipeline::note_late(double t) {
+  ++stats_.late_to_clock;
+  if (warned_late_) return;
+  warned_late_ = true;
+  std::fprintf(stderr,
+               "rvc: warning: %s %llu: time %s is not after %s, where the clock's ticks had taken the monitors: checked "
+               "as if at %s (counted as late_to_clock; warned once)\n",
+               options_.position_name.c_str(), static_cast<unsigned long long>(pending_where_->number()),
+               number(t).c_str(), number(checker_.clock()).c_str(), number(checker_.clock()).c_str());
+}
+
+double Pipeline::next_deadline() {
+  if (!ticking()) return std::numeric_limits<double>::infinity();
+  return checker_.robustness() ? checker_.next_deadline_robust(margins()) : checker_.next_deadline(values(), bound());
+}
+
+void Pipeline::tick(double stream_now) {
+  if (!ticking()) return;
+  step_to(stream_now);
+}
+
+void Pipeline::step_to(double instant) {
+  try {
+    if (checker_.robustness()) checker_.tick_robust(instant, margins());
+    else checker_.tick(instant, values(), bound());
+  } catch (const engine::data::DataLimitError& e) {  // named as a step's error names its message
+    throw engine::data::DataLimitError("tick at time " + number(instant) + ": " + e.what());
+  }
 }
 
 bool Pipeline::oversized(std::string_view payload, uint64_t position) {

@@ -353,6 +353,11 @@ void SyncedPipeline::on_set(const sync::Member* members, size_t count, double se
              std::to_string(last_time_) + " (dense time needs strictly increasing times; set skipped)");
       return;
     }
+    if (has_time_ && set_stamp <= checker_.clock() && checker_.clock() > last_time_ && late_to_clock_++ == 0)
+      std::fprintf(stderr,
+                   "rvc: warning: set at time %s is not after %s, where the clock's ticks had taken the monitors: "
+                   "checked as if at that instant (counted as late_to_clock; warned once)\n",
+                   stamp_text(set_stamp).c_str(), stamp_text(checker_.clock()).c_str());
     // The set closes [previous time, its time) with the previous values.
     if (!options_.parse_only) checker_.step(has_time_ ? last_time_ : 0, set_stamp, combined_.data());
   }
@@ -433,6 +438,16 @@ void SyncedPipeline::idle() {
   if (clocked) policy_->advance(now);
 }
 
+double SyncedPipeline::next_deadline() {
+  return ticking() ? checker_.next_deadline(combined_.data()) : std::numeric_limits<double>::infinity();
+}
+
+void SyncedPipeline::tick(double stream_now) {
+  if (ticking()) step_to(stream_now);
+}
+
+void SyncedPipeline::step_to(double instant) { checker_.tick(instant, combined_.data()); }
+
 void SyncedPipeline::end_of_input() {
   if (ended_) return;
   ended_ = true;
@@ -476,6 +491,7 @@ void SyncedPipeline::finish_report() {
 
 const PipelineStats& SyncedPipeline::stats() const {
   stats_ = PipelineStats{0, sets_rejected_, 0};
+  stats_.late_to_clock = late_to_clock_;
   for (const Input& in : inputs_) {
     stats_.accepted += in.counters.used;
     stats_.rejected += in.pipeline->stats().rejected + in.counters.out_of_order;
