@@ -113,7 +113,11 @@ Outcome check_bag(const std::vector<BagInput>& inputs, Feed& feed, VerdictOutput
     }
     // Stopped by a signal, the recording did not end where reading did.
     if (tick_at_end && !outcome.incomplete && !std::isnan(last_stamp)) {
-      feed.end_of_input();  // what a synchronizer still holds, first
+      feed.end_of_input();  // what a synchronizer still holds, first: checked as the recording ends
+      if (const double stamp = feed.last_stamp(); !(stamp == last_stamp)) {
+        last_stamp = stamp;
+        stamp_log = end_log;
+      }
       feed.tick(last_stamp + std::max(0.0, end_log - stamp_log));
     }
     if (skipped > kShown)
