@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cmath>
 #include <condition_variable>
 #include <memory>
 #include <mutex>
@@ -17,6 +18,7 @@
 #include "runtime/monitor_loop.hpp"
 #include "runtime/pipeline.hpp"
 #include "runtime/stream_clock.hpp"
+#include "runtime/synced_pipeline.hpp"
 #include "runtime/verdict_outputs.hpp"
 
 namespace rvc::runtime {
@@ -96,6 +98,70 @@ TEST(StreamClock, ParsesItsNames) {
   EXPECT_EQ(parse_clock("auto"), ClockKind::Auto);
   EXPECT_EQ(parse_clock("off"), ClockKind::Off);
   EXPECT_FALSE(parse_clock("ros").has_value());
+}
+
+using Verdicts = std::vector<std::pair<double, bool>>;
+
+// Ticks at every deadline until none is left (at most 10): what the loop does
+// over a long silence.
+std::vector<double> tick_through(Feed& feed) {
+  std::vector<double> ticks;
+  for (double d = feed.next_deadline(); d < INFINITY && ticks.size() < 10; d = feed.next_deadline()) {
+    feed.tick(d);
+    ticks.push_back(d);
+  }
+  return ticks;
+}
+
+// The Feed contract on Pipeline, by hand: after {alive} at 0.25 and {!alive}
+// at 0.5, the only deadline is 0.625, where once[0:0.125] falls (the value
+// at 0.5 is true, as already reported: verdicts are changes), then none.
+TEST(FeedTicks, PipelineTicksAtItsDeadlines) {
+  Verdicts out;
+  PipelineOptions po;
+  po.model = engine::TimeModel::Dense;
+  Pipeline p({{"p", "once[0:0.125]{alive}"}}, po, [&](const engine::Verdict& v) { out.emplace_back(v.time, v.value); });
+  EXPECT_EQ(p.next_deadline(), INFINITY);  // nothing taken yet: no clock
+  EXPECT_TRUE(std::isnan(p.last_stamp()));
+  p.feed(R"({"time":0.25,"alive":true})", 1);
+  p.feed(R"({"time":0.5,"alive":false})", 2);
+  EXPECT_EQ(p.last_stamp(), 0.5);
+  EXPECT_EQ(tick_through(p), (std::vector<double>{0.625}));
+  EXPECT_EQ(out, (Verdicts{{0, false}, {0.25, true}, {0.625, false}}));
+  p.tick(0.1);  // behind the clock: nothing
+  p.feed(R"({"time":0.6,"alive":true})", 3);  // before the ticks' 0.625: checked there, counted
+  EXPECT_EQ(p.stats().late_to_clock, 1u);
+  EXPECT_EQ(p.stats().accepted, 3u);
+  tick_through(p);
+  EXPECT_EQ(out.back(), (std::pair<double, bool>{0.625, true}));
+}
+
+TEST(FeedTicks, DiscreteTimeHasNoDeadline) {
+  PipelineOptions po;
+  Pipeline p({{"p", "once[0:2]{alive}"}}, po, [](const engine::Verdict&) {});
+  p.feed(R"({"alive":true})", 1);
+  EXPECT_EQ(p.next_deadline(), INFINITY);
+}
+
+// SyncedPipeline ticks with its combined values: input a stops being alive
+// at 0.5 while b goes on to 0.51; the fall comes at 0.625 by a tick.
+TEST(FeedTicks, SyncedPipelineTicksWithTheLatestSet) {
+  Verdicts out;
+  PipelineOptions po;
+  po.model = engine::TimeModel::Dense;
+  SyncOptions so;
+  so.policy = sync::PolicyKind::Merge;
+  SyncedPipeline p({{"p", "once[0:0.125]{a.alive}"}}, po, {{"a", "test:a", nullptr, ""}, {"b", "test:b", nullptr, ""}},
+                   so, [&](const engine::Verdict& v) { out.emplace_back(v.time, v.value); });
+  EXPECT_EQ(p.next_deadline(), INFINITY);
+  p.feed_at(0, R"({"time":0.25,"alive":true})", 1, 0);
+  p.feed_at(1, R"({"time":0.26,"v":1})", 2, 0);
+  p.feed_at(0, R"({"time":0.5,"alive":false})", 3, 0);
+  p.feed_at(1, R"({"time":0.51,"v":2})", 4, 0);
+  p.end_of_input();  // every set formed
+  EXPECT_EQ(p.last_stamp(), 0.51);
+  tick_through(p);
+  EXPECT_EQ(out.back(), (std::pair<double, bool>{0.625, false}));
 }
 
 // Verdict lines, and a signal to the source when one arrives.
