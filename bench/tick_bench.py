@@ -10,7 +10,8 @@ silent for 50 ms. The property falls 20 ms after the false message's stamp: that
 false verdict's own "time", so the latency is its arrival at this script's subscriber
 (time.time()) minus its "time": missed deadline -> verdict received, no message involved. Beside
 it, in the same run, the transport's one-way floor: the same script subscribes to the input too
-and takes each message's arrival minus its stamp.
+and takes each message's arrival minus its stamp. rvc's own counters add `tick_lag_us`: how late
+its engine thread woke for each deadline it slept for (the scheduler's part of the latency).
 
 Idle cost (Zenoh, loopback): a monitor whose clock has nothing due, sampled for 10 s from
 /proc/PID/stat (CPU) and /proc/PID/task/*/status (voluntary context switches over every thread:
@@ -158,7 +159,7 @@ def latency_run(rvc, transport, silences, tmp):
     return {"transport": transport, "silences": silences,
             "detection_us": summary([x * 1e6 for x in falls]),
             "floor_us": summary([x * 1e6 for x in floor]),
-            "stats": {k: stats.get(k) for k in ("received", "checked", "ticks", "late_to_clock", "clock")}}
+            "stats": {k: stats.get(k) for k in ("received", "checked", "ticks", "late_to_clock", "clock", "tick_lag_us")}}
 
 
 # ---------------------------------------------------------------- idle cost
@@ -231,6 +232,10 @@ def table(results):
                            ("missed deadline → false verdict at the subscriber", "detection_us")]:
             s = r[key]
             lines.append(f"| {r['transport']} | {label} | {s['n']} | {s['p50']:.0f} | {s['p99']:.0f} | {s['max']:.0f} |")
+        lag = r["stats"].get("tick_lag_us")
+        if lag:
+            lines.append(f"| {r['transport']} | inside rvc: deadline → the engine thread's wake-up (`tick_lag_us`) | "
+                         f"{r['stats'].get('ticks')} ticks | {lag['p50']:.0f} | {lag['p99']:.0f} | {lag['max']:.0f} |")
     lines += ["", "| idle monitor (Zenoh) | clock | CPU, % of a core | wake-ups/s (all threads) | ticks |",
               "|---|---|---:|---:|---:|"]
     for r in results["idle"]:

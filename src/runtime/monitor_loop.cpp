@@ -117,8 +117,20 @@ std::string MonitorLoop::stats_json() const {
     out.add_raw("inputs", inputs.str());
   }
   if (options_.filter) out.add("filtered", filtered_);
-  if (options_.clock != ClockKind::Off)
+  if (options_.clock != ClockKind::Off) {
     out.add("clock", to_string(clock_.kind())).add("ticks", ticks_).add("late_to_clock", p.late_to_clock);
+    if (!tick_lag_.empty()) {  // microseconds from each deadline to the wake-up that ticked it
+      std::vector<float> lag = tick_lag_;
+      auto at = [&](double q) {
+        auto k = lag.begin() + static_cast<std::ptrdiff_t>(q * static_cast<double>(lag.size() - 1));
+        std::nth_element(lag.begin(), k, lag.end());
+        return std::round(*k * 1e6);
+      };
+      io::JsonObject summary;
+      summary.add("p50", at(0.5)).add("p99", at(0.99)).add("max", at(1.0));
+      out.add("tick_lag_us", summary);
+    }
+  }
   feed_.add_stats(out);
   return out.add_fixed("first_at", first_at_, 6).add_fixed("done_at", wall_now(), 6).str();
 }
@@ -194,7 +206,7 @@ void MonitorLoop::follow_stamps(std::chrono::steady_clock::time_point now) {
   }
 }
 
-std::chrono::steady_clock::time_point MonitorLoop::run_ticks(std::chrono::steady_clock::time_point now) {
+std::chrono::steady_clock::time_point MonitorLoop::run_ticks(std::chrono::steady_clock::time_point now, bool slept) {
   using clock = std::chrono::steady_clock;
   if (!clock_.running()) return clock::time_point::max();
   bool ticked = false;
@@ -203,6 +215,9 @@ std::chrono::steady_clock::time_point MonitorLoop::run_ticks(std::chrono::steady
   // Each deadline reached, in order, each tick exactly at its instant (a
   // burst of them after a long stop of the process, say, is made at once).
   while (next <= now) {
+    // A deadline the loop slept for (not one a message's arrival had
+    // already passed, such as the message's own instant): how late it woke.
+    if (slept && tick_lag_.size() < 65536) tick_lag_.push_back(static_cast<float>(clock_.now(now) - deadline));
     feed_.tick(deadline);
     ++ticks_;
     ticked = true;
@@ -309,7 +324,7 @@ void MonitorLoop::process(const std::vector<transport::Source*>& sources) {
       }
       follow_stamps(now);
     }
-    next_tick = run_ticks(now);
+    next_tick = run_ticks(now, count == 0);
     on_schedule(now);
     if (eos_ && options_.exit_on_eos) {
       end_ = EndReason::EndOfStream;

@@ -102,8 +102,9 @@ class MonitorLoop {
   // The clock: after a batch (the feed's newest stamp) and on every wake-up.
   void follow_stamps(std::chrono::steady_clock::time_point now);
   // Ticks at every deadline the clock has reached (and at --tick's bound);
-  // returns when the next tick is due (steady max: none).
-  std::chrono::steady_clock::time_point run_ticks(std::chrono::steady_clock::time_point now);
+  // returns when the next tick is due (steady max: none). `slept`: the wait
+  // ended with no message (at a deadline, or a duty).
+  std::chrono::steady_clock::time_point run_ticks(std::chrono::steady_clock::time_point now, bool slept);
   // The first of the scheduled duties (counters, record, idle timeout) and
   // the next tick: how long the loop may sleep when no message comes.
   std::chrono::steady_clock::time_point wake_at(std::chrono::steady_clock::time_point now,
@@ -128,6 +129,10 @@ class MonitorLoop {
   double clock_stamp_ = 0;  // the feed's stamp the clock was last set from
   bool clock_said_ = false;
   uint64_t ticks_ = 0;      // ticks made (each at a deadline or at --tick's bound)
+  // How late each deadline tick the loop slept for was on the clock
+  // (seconds): the engine thread's wake-up, summarized in the counters as
+  // tick_lag_us (the first 65,536).
+  std::vector<float> tick_lag_;
   std::chrono::steady_clock::time_point last_tick_{};
   double first_at_ = 0;  // wall clock of the first message (benchmarks compare across processes)
 };
