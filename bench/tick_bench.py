@@ -235,7 +235,7 @@ def table(results):
         lag = r["stats"].get("tick_lag_us")
         if lag:
             lines.append(f"| {r['transport']} | inside rvc: deadline → the engine thread's wake-up (`tick_lag_us`) | "
-                         f"{r['stats'].get('ticks')} ticks | {lag['p50']:.0f} | {lag['p99']:.0f} | {lag['max']:.0f} |")
+                         f"those slept for, of {r['stats'].get('ticks')} ticks | {lag['p50']:.0f} | {lag['p99']:.0f} | {lag['max']:.0f} |")
     lines += ["", "| idle monitor (Zenoh) | clock | CPU, % of a core | wake-ups/s (all threads) | ticks |",
               "|---|---|---:|---:|---:|"]
     for r in results["idle"]:
