@@ -244,7 +244,7 @@ struct LoopRun {
 };
 
 void run_loop(LoopRun& r, const std::string& spec, ClockKind clock, std::vector<std::string> before,
-              const std::string& awaited, std::vector<std::string> after) {
+              const std::string& awaited, std::vector<std::string> after, double tick_bound = 0) {
   std::vector<std::unique_ptr<transport::Sink>> sinks;
   sinks.push_back(std::make_unique<CollectingSink>(r.collected));
   VerdictOutputs outputs(std::move(sinks), false);
@@ -256,10 +256,12 @@ void run_loop(LoopRun& r, const std::string& spec, ClockKind clock, std::vector<
   lo.input = "test";
   lo.exit_on_eos = true;
   lo.clock = clock;
+  lo.tick_bound = tick_bound;
   MonitorLoop loop(pipeline, outputs, nullptr, lo);
   // Without a clock nothing can come: half a second shows it (with one, the
   // verdict ends the wait, and 5 s only bound a failing run).
-  SilentSource source(r.collected, std::move(before), awaited, std::move(after), clock == ClockKind::Off ? 500ms : 5s);
+  SilentSource source(r.collected, std::move(before), awaited, std::move(after),
+                      clock == ClockKind::Off || awaited == "never" ? 500ms : 5s);
   loop.run(source);
   r.seen_before_resume = source.seen_before_resume;
   r.ticks = loop.ticks();
@@ -300,6 +302,17 @@ TEST(MonitorLoopClock, ReportsARiseDuringSilence) {
            {R"({"time":0.25,"ok":false})", R"({"time":0.5,"ok":true})"},
            R"({"time":0.625,"property":"p","value":true})", {R"({"time":5,"ok":true})"});
   EXPECT_TRUE(r.seen_before_resume);
+}
+
+// --tick: with no deadline at all ({alive} holds and nothing can change),
+// the fallback still ticks during a silence; without it no tick is made.
+TEST(MonitorLoopClock, TickBoundTicksWithoutDeadlines) {
+  LoopRun bounded, plain;
+  const std::vector<std::string> before = {R"({"time":0.25,"alive":true})"};
+  run_loop(bounded, "{alive}", ClockKind::Stamps, before, "never", {R"({"time":5,"alive":true})"}, 0.02);
+  EXPECT_GE(bounded.ticks, 3u);  // the message's own instant, then a half-second silence ticked every 20 ms
+  run_loop(plain, "{alive}", ClockKind::Stamps, before, "never", {R"({"time":5,"alive":true})"});
+  EXPECT_EQ(plain.ticks, 1u);  // only the message's own instant (true at 0.25); nothing due after it
 }
 
 // A message stamped before the instant ticks reached is still checked, at
