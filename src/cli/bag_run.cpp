@@ -6,7 +6,8 @@ namespace rvc::cli {
 
 BagRun run_bag(const std::string& path, const std::vector<std::string>& topics,
                const std::vector<engine::PropertySpec>& properties, runtime::PipelineOptions options,
-               const SyncFlags& sync, msg::TypeRegistry& registry, runtime::VerdictOutputs& outputs) {
+               const SyncFlags& sync, msg::TypeRegistry& registry, runtime::VerdictOutputs& outputs,
+               bool tick_at_end) {
   BagRun run;
   install_stop_signals();
   options.position_name = "message";
@@ -20,7 +21,7 @@ BagRun run_bag(const std::string& path, const std::vector<std::string>& topics,
     run.description = "topic " + bag.topic + " (" + (bag.type ? bag.type->full_name() : std::string("JSON")) + ", " +
                       std::to_string(bag.messages) + " messages)";
     uint64_t skipped = 0;
-    run.outcome = runtime::check_bag({bag}, pipeline, outputs, skipped, stop_requested);
+    run.outcome = runtime::check_bag({bag}, pipeline, outputs, skipped, stop_requested, tick_at_end);
     run.stopped = stop_requested();
     run.stats = pipeline.stats();
     run.stats.rejected += skipped;  // the bag's bad records: rejected input like a malformed message
@@ -41,7 +42,7 @@ BagRun run_bag(const std::string& path, const std::vector<std::string>& topics,
   }
   run.description += std::string(", sync ") + sync::to_string(sync.options(inputs).policy);
   uint64_t skipped = 0;
-  run.outcome = runtime::check_bag(bags, pipeline, outputs, skipped, stop_requested);
+  run.outcome = runtime::check_bag(bags, pipeline, outputs, skipped, stop_requested, tick_at_end);
   run.stopped = stop_requested();
   run.stats = pipeline.stats();
   run.stats.rejected += skipped;

@@ -33,8 +33,11 @@ struct BagRun {
 // Throws as select_bag_topic(s) for a bad choice of topics; `sync` applies
 // with several topics. SIGINT/SIGTERM end the bag where it is (what was read
 // is checked; the outcome is incomplete), as they end every other input.
+// `tick_at_end` (dense time, --clock auto): the bag's own clock ticks at its
+// end (runtime::check_bag).
 BagRun run_bag(const std::string& path, const std::vector<std::string>& topics,
                const std::vector<engine::PropertySpec>& properties, runtime::PipelineOptions options,
-               const SyncFlags& sync, msg::TypeRegistry& registry, runtime::VerdictOutputs& outputs);
+               const SyncFlags& sync, msg::TypeRegistry& registry, runtime::VerdictOutputs& outputs,
+               bool tick_at_end = false);
 
 }  // namespace rvc::cli

@@ -8,6 +8,7 @@
 #include <memory>
 
 #include "cli/check_options.hpp"
+#include "cli/clock_options.hpp"
 #include "cli/commands.hpp"
 #include "cli/signals.hpp"
 #include "cli/store_options.hpp"
@@ -29,6 +30,7 @@ std::string strip_file_scheme(const std::string& uri) { return uri.rfind("file:"
 
 struct CheckCommand {
   CheckOptions check;
+  ClockFlags clock;  // --clock auto|off: a tick at the recording's end
   std::string input;
   std::vector<std::string> outputs;  // verdict files (one) and a results database
   std::string output = "-";
@@ -88,7 +90,8 @@ struct CheckCommand {
     install_stop_signals();
     end_input_on_stop(fd);
     // Reading stdin: show each verdict as soon as it is known.
-    runtime::Outcome outcome = runtime::check_stream(fd, pipeline, outputs, ropts, path == "-");
+    runtime::Outcome outcome = runtime::check_stream(fd, pipeline, outputs, ropts, path == "-",
+                                                             clock.ticks_at_end(check.dense));
     end_input_on_stop(-1);
     if (fd != 0) ::close(fd);
     report(pipeline.stats(), pipeline.violations());
@@ -138,7 +141,7 @@ struct CheckCommand {
       results->attach(input, popts, outputs);
       results->start(runtime::run_info(command_line(), {input}, properties, check.dense));
     }
-    BagRun run = cli::run_bag(path, topics, properties, popts, sync, registry, outputs);
+    BagRun run = cli::run_bag(path, topics, properties, popts, sync, registry, outputs, clock.ticks_at_end(check.dense));
     if (summary) std::fprintf(stderr, "rvc check: %s, %s\n", path.c_str(), run.description.c_str());
     report(run.stats, run.violations);
     if (stats) std::fprintf(stderr, "%s\n", run.counters_json(input, outputs.count()).c_str());
@@ -188,6 +191,7 @@ Runner register_check(CLI::App& app) {
                   "A bag's types that its schemas name but do not define: a folder of .msg/.idl definitions (a ROS 2 "
                   "share/ tree or a plain folder) or one .idl file (repeatable)");
   cmd->sync.add_to(*sub);
+  cmd->clock.add_offline(*sub);
   sub->add_option("--output,-o", cmd->outputs,
                   "Where verdicts go: PATH, file:PATH or - (stdout, the default); repeatable for results databases: "
                   "sqlite:PATH or postgresql://... (docs/results.md)");

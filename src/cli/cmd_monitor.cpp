@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "cli/check_options.hpp"
+#include "cli/clock_options.hpp"
 #include "cli/option_ranges.hpp"
 #include "cli/commands.hpp"
 #include "cli/diagnostics_flags.hpp"
@@ -35,6 +36,7 @@ namespace {
 
 struct MonitorCommand {
   CheckOptions check;
+  ClockFlags clock;  // --clock, --tick: dense time moves on while no message comes
   transport::TransportOptions transports;
   std::vector<std::string> inputs;     // --input: one URI, or several NAME=URI
   CLI::Option* input_option = nullptr;
@@ -212,7 +214,8 @@ struct MonitorCommand {
       runtime::check_specs(properties, check.dense);
     start_results({input}, properties);
     for (const auto& dir : typed.msg_paths) typed.registry.add_search_path(dir);  // what the schemas leave out
-    BagRun run = cli::run_bag(path, topics, properties, popts, sync, typed.registry, verdicts);
+    BagRun run =
+        cli::run_bag(path, topics, properties, popts, sync, typed.registry, verdicts, clock.ticks_at_end(check.dense));
     std::fprintf(stderr, "rvc monitor: %s\n", run.description.c_str());
     const std::string stats = run.counters_json(input, verdicts.count());
     std::fprintf(stderr, "%s\n", stats.c_str());
@@ -367,6 +370,7 @@ struct MonitorCommand {
     lopts.queue_capacity = queue_capacity;
     lopts.stop_requested = stop_requested;
     lopts.stats_requested = stats_requested;
+    clock.apply(lopts, check.dense, from_file);
     return lopts;
   }
 
@@ -526,6 +530,7 @@ Runner register_monitor(CLI::App& app) {
   sub->add_option("--topic", cmd->topics,
                   "With --input mcap:BAG: the topic to check (if the bag holds several); repeatable: NAME=TOPIC, "
                   "synchronized by --sync");
+  cmd->clock.add_live(*sub);
   sub->add_option("--queue", cmd->queue_capacity, "Messages buffered between transport and engine")
       ->check(in_range(1, kMaxQueue))
       ->capture_default_str();

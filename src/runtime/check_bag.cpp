@@ -1,7 +1,10 @@
 #include "runtime/check_bag.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <exception>
+#include <limits>
 #include <stdexcept>
 
 #include "runtime/check_stream.hpp"
@@ -67,7 +70,7 @@ BagInput select_bag_topic(const std::string& path, const std::string& topic, msg
 }
 
 Outcome check_bag(const std::vector<BagInput>& inputs, Feed& feed, VerdictOutputs& outputs, uint64_t& skipped,
-                  const std::function<bool()>& stop) {
+                  const std::function<bool()>& stop, bool tick_at_end) {
   skipped = 0;
   return run_check(feed, outputs, [&](Outcome& outcome) {
     transport::McapBag bag(inputs.at(0).path);
@@ -77,6 +80,8 @@ Outcome check_bag(const std::vector<BagInput>& inputs, Feed& feed, VerdictOutput
       outcome.rejected = true;
     });
     transport::McapMessage m;
+    double end_log = 0;  // the latest log time of any message: where the recording ends
+    double last_stamp = std::numeric_limits<double>::quiet_NaN(), stamp_log = 0;
     for (uint64_t n = 0;; ++n) {
       // Asked every 64 messages: a stop signal ends the bag within microseconds.
       if (stop && (n & 63) == 0 && stop()) {
@@ -94,8 +99,26 @@ Outcome check_bag(const std::vector<BagInput>& inputs, Feed& feed, VerdictOutput
         outcome.rejected = true;
         break;
       }
+      const double log_time = m.log_time * 1e-9;
+      end_log = std::max(end_log, log_time);
       for (size_t i = 0; i < inputs.size(); ++i)
-        if (m.topic == inputs[i].topic) feed.feed_logged(static_cast<uint32_t>(i), m.data, m.index, m.log_time * 1e-9);
+        if (m.topic == inputs[i].topic) {
+          feed.feed_logged(static_cast<uint32_t>(i), m.data, m.index, log_time);
+          const double stamp = feed.last_stamp();
+          if (!(stamp == last_stamp)) {  // the monitors took a message: stream time `stamp` at this log time
+            last_stamp = stamp;
+            stamp_log = log_time;
+          }
+        }
+    }
+    // Stopped by a signal, the recording did not end where reading did.
+    if (tick_at_end && !outcome.incomplete && !std::isnan(last_stamp)) {
+      feed.end_of_input();  // what a synchronizer still holds, first: checked as the recording ends
+      if (const double stamp = feed.last_stamp(); !(stamp == last_stamp)) {
+        last_stamp = stamp;
+        stamp_log = end_log;
+      }
+      feed.tick(last_stamp + std::max(0.0, end_log - stamp_log));
     }
     if (skipped > kShown)
       std::fprintf(stderr, "rvc: bag '%s': %llu more bad records were skipped and not shown\n", bag.path().c_str(),

@@ -43,8 +43,16 @@ BagInput select_bag_topic(const std::string& path, const std::string& topic, msg
 // `stop` (may be empty) is asked between messages: when it says so (a stop
 // signal), reading ends there, what was read is checked, and the outcome is
 // incomplete (the bag was not read to its end).
+//
+// `tick_at_end` (dense time on the bag's own clock): after the last message,
+// a tick at the recording's end, so what falls after the last message of the
+// checked topics but before the recording ends is reported. The recording's
+// end is the latest log time of any message in the bag (what the MCAP
+// statistics record call message_end_time); in stream time (the messages'
+// stamps) it is the last stamp the monitors took plus the log time that
+// passed after its message.
 Outcome check_bag(const std::vector<BagInput>& inputs, Feed& feed, VerdictOutputs& outputs, uint64_t& skipped,
-                  const std::function<bool()>& stop = {});
+                  const std::function<bool()>& stop = {}, bool tick_at_end = false);
 
 // Several topics of a bag: "NAME=TOPIC" or "TOPIC" (named by its last part,
 // "/vehicle/status/gear_status" -> gear_status). The inputs to synchronize,

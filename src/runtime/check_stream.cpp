@@ -45,14 +45,17 @@ void add_run_counters(io::JsonObject& out, const Feed& feed, uint64_t verdicts) 
       .add("violations", feed.violations());
 }
 
-Outcome check_stream(int fd, Pipeline& pipeline, VerdictOutputs& outputs, io::ReaderOptions reader, bool live) {
+Outcome check_stream(int fd, Pipeline& pipeline, VerdictOutputs& outputs, io::ReaderOptions reader, bool live,
+                     bool tick_at_end) {
   if (live) reader.after_chunk = [&outputs] { outputs.idle(); };
   return run_check(pipeline, outputs, [&](Outcome& outcome) {
     std::string error;
     if (!io::read_jsonl(fd, pipeline, reader, error)) {
       std::fprintf(stderr, "rvc: error: %s\n", error.c_str());
       outcome.runtime_failure = true;
+      return;
     }
+    if (tick_at_end) pipeline.tick(pipeline.last_stamp());  // NaN (nothing taken): no tick
   });
 }
 

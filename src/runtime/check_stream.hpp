@@ -16,7 +16,10 @@ namespace rvc::runtime {
 // error, an output that cannot be written): the outcome says so and the
 // reason is printed. `live`: flush verdicts after every chunk read (stdin fed
 // by another program, where verdicts should show as soon as they are known).
-Outcome check_stream(int fd, Pipeline& pipeline, VerdictOutputs& outputs, io::ReaderOptions reader, bool live);
+// `tick_at_end` (dense time, --clock auto): a tick at the last stamp reports
+// the last message's own verdicts (its segment has no end otherwise).
+Outcome check_stream(int fd, Pipeline& pipeline, VerdictOutputs& outputs, io::ReaderOptions reader, bool live,
+                     bool tick_at_end = false);
 
 // The frame of every check run: `read` feeds the pipeline (and may note
 // what it met in the outcome), then the outputs get their end-of-stream

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <string_view>
 
 #include "io/json_writer.hpp"
@@ -17,6 +18,9 @@ struct PipelineStats {
   uint64_t rejected = 0;  // messages refused (malformed, wrong time order, strict-mode problems)
   uint64_t warnings = 0;  // fields that kept their previous value (wrong type)
   uint64_t by_layout = 0;  // of the accepted, read by a learned layout without a parse (io/json_layout.hpp)
+  // Dense time on a clock: accepted messages stamped at or before the
+  // instant ticks had reached; checked, taking effect at that instant.
+  uint64_t late_to_clock = 0;
 };
 
 class Feed {
@@ -32,6 +36,23 @@ class Feed {
     feed_input(input, payload, position);
   }
   virtual void warn(const io::LineError& warning) = 0;
+
+  // ---- Dense time on a clock (docs/semantics.md, "Ticks") ----
+  // The only way time moves without a message: the loop asks for the next
+  // deadline after every message and tick, waits until its clock reaches it
+  // (or a message comes) and ticks there. Stream time, in the messages'
+  // own unit (seconds).
+  //
+  // The first instant at which some verdict can change with every field
+  // holding its value; +inf when none can (discrete time, nothing accepted
+  // yet, a decode-only feed).
+  virtual double next_deadline() { return std::numeric_limits<double>::infinity(); }
+  // An empty message at `stream_now`: verdicts up to and at that instant.
+  // Before the instant already reached: nothing.
+  virtual void tick(double stream_now) { (void)stream_now; }
+  // The stamp of the last message the monitors took (NaN: none yet): what
+  // the loop's clock is set from.
+  virtual double last_stamp() const { return std::numeric_limits<double>::quiet_NaN(); }
   // No message is pending (the loop is waiting): time-driven work.
   virtual void idle() {}
   // Every input has ended (end-of-stream, file end): nothing more will come.

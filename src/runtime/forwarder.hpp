@@ -33,6 +33,9 @@ class Forwarder final : public Feed {
     sink_->idle();
   }
   void end_of_input() override { inner_.end_of_input(); }
+  double next_deadline() override { return inner_.next_deadline(); }
+  void tick(double stream_now) override { inner_.tick(stream_now); }
+  double last_stamp() const override { return inner_.last_stamp(); }
   const PipelineStats& stats() const override { return inner_.stats(); }
   uint64_t violations() const override { return inner_.violations(); }
   void finish_report() override { inner_.finish_report(); }

@@ -1,6 +1,9 @@
 #include "runtime/monitor_loop.hpp"
 
+#include <sys/prctl.h>
+
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <stdexcept>
 #include <vector>
@@ -16,6 +19,9 @@ namespace {
 double wall_now() {
   return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
 }
+
+// The longest sleep when nothing is due: how soon a stop signal is seen.
+constexpr int kHousekeepingMs = 100;
 
 // Closes the queue, then stops the sources, however run() is left.
 class Shutdown {
@@ -111,6 +117,20 @@ std::string MonitorLoop::stats_json() const {
     out.add_raw("inputs", inputs.str());
   }
   if (options_.filter) out.add("filtered", filtered_);
+  if (options_.clock != ClockKind::Off) {
+    out.add("clock", to_string(clock_.kind())).add("ticks", ticks_).add("late_to_clock", p.late_to_clock);
+    if (!tick_lag_.empty()) {  // microseconds from each deadline to the wake-up that ticked it
+      std::vector<float> lag = tick_lag_;
+      auto at = [&](double q) {
+        auto k = lag.begin() + static_cast<std::ptrdiff_t>(q * static_cast<double>(lag.size() - 1));
+        std::nth_element(lag.begin(), k, lag.end());
+        return std::round(*k * 1e6);
+      };
+      io::JsonObject summary;
+      summary.add("p50", at(0.5)).add("p99", at(0.99)).add("max", at(1.0));
+      out.add("tick_lag_us", summary);
+    }
+  }
   feed_.add_stats(out);
   return out.add_fixed("first_at", first_at_, 6).add_fixed("done_at", wall_now(), 6).str();
 }
@@ -183,15 +203,85 @@ void MonitorLoop::handle(const transport::Frame& f) {
 void MonitorLoop::on_schedule(std::chrono::steady_clock::time_point now) {
   // Counters on request or on schedule, also while no message comes.
   if (options_.stats_requested()) publish_stats();
-  if (options_.stats_interval > 0 && now - last_stats_ > std::chrono::duration<double>(options_.stats_interval)) {
+  if (options_.stats_interval > 0 && now - last_stats_ >= std::chrono::duration<double>(options_.stats_interval)) {
     last_stats_ = now;
     publish_stats();
   }
-  if (options_.on_record && now - last_record_ > std::chrono::duration<double>(options_.record_interval)) {
+  if (options_.on_record && now - last_record_ >= std::chrono::duration<double>(options_.record_interval)) {
     last_record_ = now;
     options_.on_record(stats_json());
   }
   if (options_.on_tick) options_.on_tick(*this, now);
+}
+
+void MonitorLoop::follow_stamps(std::chrono::steady_clock::time_point now) {
+  if (options_.clock == ClockKind::Off) return;
+  const double stamp = feed_.last_stamp();
+  if (std::isnan(stamp) || (clock_.running() && stamp == clock_stamp_)) return;
+  clock_stamp_ = stamp;
+  clock_.on_message(stamp, now);
+  if (!clock_said_ && clock_.running()) {  // said once, when it starts
+    clock_said_ = true;
+    std::fprintf(stderr, "rvc monitor: dense time on the %s clock%s%s: ticks at the properties' deadlines%s\n",
+                 to_string(clock_.kind()), clock_.reason().empty() ? "" : " (",
+                 clock_.reason().empty() ? "" : (clock_.reason() + ")").c_str(),
+                 options_.tick_bound > 0 ? " and at least every --tick" : "");
+  }
+}
+
+std::chrono::steady_clock::time_point MonitorLoop::run_ticks(std::chrono::steady_clock::time_point now, bool slept) {
+  using clock = std::chrono::steady_clock;
+  if (!clock_.running()) return clock::time_point::max();
+  bool ticked = false;
+  double deadline = feed_.next_deadline();
+  auto next = clock_.when(deadline, now);
+  // Each deadline reached, in order, each tick exactly at its instant (a
+  // burst of them after a long stop of the process, say, is made at once).
+  while (next <= now) {
+    // A deadline the loop slept for (not one a message's arrival had
+    // already passed, such as the message's own instant): how late it woke.
+    if (slept && tick_lag_.size() < 65536) tick_lag_.push_back(static_cast<float>(clock_.now(now) - deadline));
+    feed_.tick(deadline);
+    ++ticks_;
+    ticked = true;
+    last_tick_ = now;
+    const double after = feed_.next_deadline();
+    if (!(after > deadline)) {  // the engine promises progress; never spin if it did not
+      next = now + std::chrono::milliseconds(1);
+      break;
+    }
+    deadline = after;
+    next = clock_.when(deadline, now);
+  }
+  if (options_.tick_bound > 0) {  // --tick: the fallback bound, a tick at the clock's own now
+    const auto bound = std::chrono::duration_cast<clock::duration>(std::chrono::duration<double>(options_.tick_bound));
+    if (!ticked && now - last_tick_ >= bound) {
+      feed_.tick(clock_.now(now));
+      ++ticks_;
+      ticked = true;
+      last_tick_ = now;
+      next = clock_.when(feed_.next_deadline(), now);
+    }
+    next = std::min(next, last_tick_ + bound);
+  }
+  if (ticked) outputs_.idle();  // the tick's verdicts out now, not at the next idle flush
+  return next;
+}
+
+std::chrono::steady_clock::time_point MonitorLoop::wake_at(std::chrono::steady_clock::time_point now,
+                                                           std::chrono::steady_clock::time_point next_tick,
+                                                           std::chrono::steady_clock::time_point last_message) const {
+  using clock = std::chrono::steady_clock;
+  auto after = [](double seconds) {
+    return std::chrono::duration_cast<clock::duration>(std::chrono::duration<double>(seconds));
+  };
+  // Stop signals and the feed's and outputs' idle work (flushes, sync
+  // health) are looked at this often when nothing else is due.
+  auto wake = std::min(next_tick, now + std::chrono::milliseconds(kHousekeepingMs));
+  if (options_.stats_interval > 0) wake = std::min(wake, last_stats_ + after(options_.stats_interval));
+  if (options_.on_record) wake = std::min(wake, last_record_ + after(options_.record_interval));
+  if (options_.idle_timeout > 0) wake = std::min(wake, last_message + after(options_.idle_timeout));
+  return wake;
 }
 
 void MonitorLoop::process(const std::vector<transport::Source*>& sources) {
@@ -199,7 +289,12 @@ void MonitorLoop::process(const std::vector<transport::Source*>& sources) {
   input_eos_.assign(sources.size(), false);
   input_last_.assign(sources.size(), std::chrono::steady_clock::now());
   for (auto& c : counters_) c.expect(options_.publishers);
-  last_stats_ = last_record_ = std::chrono::steady_clock::now();
+  last_stats_ = last_record_ = last_tick_ = std::chrono::steady_clock::now();
+  clock_ = StreamClock(options_.clock, options_.time);
+  // Deadlines are met to the timer's precision: the kernel may defer a
+  // sleeping thread's wake-up by its timer slack (50 us by default); 1 us
+  // on this thread (the engine's) costs nothing while it sleeps.
+  if (options_.clock != ClockKind::Off) ::prctl(PR_SET_TIMERSLACK, 1000UL, 0, 0, 0);
   if (feed_.reads_in_order()) return process_in_order(sources);
   transport::FrameQueue queue(options_.queue_capacity);
   Shutdown shutdown(queue, sources);
@@ -215,6 +310,7 @@ void MonitorLoop::process(const std::vector<transport::Source*>& sources) {
   using clock = std::chrono::steady_clock;
   const auto idle_limit = std::chrono::duration<double>(options_.idle_timeout);
   auto last_message = clock::now();
+  auto next_tick = clock::time_point::max();
   std::vector<transport::OwnedFrame> batch;
   size_t count = 0;
   for (;;) {
@@ -222,7 +318,9 @@ void MonitorLoop::process(const std::vector<transport::Source*>& sources) {
       end_ = EndReason::Stopped;
       break;
     }
-    if (!queue.pop_batch(batch, count, 100)) {
+    // No polling period: the wait ends at a message, at the next tick's
+    // deadline, or at the next scheduled duty, whichever comes first.
+    if (!queue.pop_batch_until(batch, count, wake_at(clock::now(), next_tick, last_message))) {
       end_ = EndReason::SourceClosed;
       break;
     }
@@ -230,7 +328,7 @@ void MonitorLoop::process(const std::vector<transport::Source*>& sources) {
     if (count == 0) {
       feed_.idle();
       outputs_.idle();
-      if (options_.idle_timeout > 0 && now - last_message > idle_limit) {
+      if (options_.idle_timeout > 0 && now - last_message >= idle_limit) {
         end_ = EndReason::IdleTimeout;
         break;
       }
@@ -248,7 +346,9 @@ void MonitorLoop::process(const std::vector<transport::Source*>& sources) {
         f.key = o.key;
         handle(f);
       }
+      follow_stamps(now);
     }
+    next_tick = run_ticks(now, count == 0);
     on_schedule(now);
     if (eos_ && options_.exit_on_eos) {
       end_ = EndReason::EndOfStream;
@@ -305,6 +405,8 @@ Outcome MonitorLoop::run(const std::vector<transport::Source*>& sources) {
   try {
     process(sources);
     feed_.end_of_input();  // also after a signal or idle timeout: what is held is checked
+    // A file's end: its last message's own verdicts (a tick at its stamp).
+    if (options_.tick_at_end && end_ == EndReason::EndOfStream) feed_.tick(feed_.last_stamp());
     outputs_.finish();
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rvc: error: %s\n", e.what());

@@ -18,6 +18,7 @@
 #include "runtime/exit_status.hpp"
 #include "runtime/feed.hpp"
 #include "runtime/message_filter.hpp"
+#include "runtime/stream_clock.hpp"
 #include "runtime/verdict_outputs.hpp"
 #include "transport/endpoint.hpp"
 #include "transport/seq_counter.hpp"
@@ -66,6 +67,15 @@ struct LoopOptions {
   // Called on the engine thread at least every ~100 ms while the loop runs
   // (the /diagnostics output publishes from it); may read loop.health().
   std::function<void(const MonitorLoop& loop, std::chrono::steady_clock::time_point now)> on_tick;
+  // Dense time on a clock (--clock, --tick; docs/semantics.md "Ticks"): while
+  // no message comes, the loop sleeps until the feed's next deadline on
+  // this clock and ticks there. Off: the monitors move only with messages.
+  ClockKind clock = ClockKind::Off;
+  double tick_bound = 0;  // --tick: at most this many seconds between ticks (0: deadlines only)
+  // A file input: at its end, a tick at its last stamp reports the last
+  // message's own verdicts (as `rvc check` does).
+  bool tick_at_end = false;
+  TimeSource time = TimeSource::system();
   std::function<bool()> stop_requested = [] { return false; };   // e.g. SIGINT/SIGTERM seen
   std::function<bool()> stats_requested = [] { return false; };  // e.g. SIGUSR1 seen (true once)
 };
@@ -97,6 +107,7 @@ class MonitorLoop {
   EndReason end_reason() const { return end_; }
   // The counters and each input's silence at `now` (engine thread).
   LoopHealth health(std::chrono::steady_clock::time_point now) const;
+  uint64_t ticks() const { return ticks_; }
   // The counters printed at the end of run().
   const std::string& final_stats() const { return final_stats_; }
 
@@ -109,6 +120,17 @@ class MonitorLoop {
   void handle(const transport::Frame& frame);  // one frame of either path
   // Counters on request or on schedule; false once the run should end.
   void on_schedule(std::chrono::steady_clock::time_point now);
+  // The clock: after a batch (the feed's newest stamp) and on every wake-up.
+  void follow_stamps(std::chrono::steady_clock::time_point now);
+  // Ticks at every deadline the clock has reached (and at --tick's bound);
+  // returns when the next tick is due (steady max: none). `slept`: the wait
+  // ended with no message (at a deadline, or a duty).
+  std::chrono::steady_clock::time_point run_ticks(std::chrono::steady_clock::time_point now, bool slept);
+  // The first of the scheduled duties (counters, record, idle timeout) and
+  // the next tick: how long the loop may sleep when no message comes.
+  std::chrono::steady_clock::time_point wake_at(std::chrono::steady_clock::time_point now,
+                                                std::chrono::steady_clock::time_point next_tick,
+                                                std::chrono::steady_clock::time_point last_message) const;
   bool ended() const;  // every input's publishers sent their end-of-stream markers
   uint64_t total(uint64_t transport::SeqCounters::*field) const;
 
@@ -127,6 +149,15 @@ class MonitorLoop {
   uint64_t filtered_ = 0;   // messages the filter kept from the monitor
   std::string projected_;   // the message as the filter projected it
   std::chrono::steady_clock::time_point last_stats_{}, last_record_{};
+  StreamClock clock_{ClockKind::Off};
+  double clock_stamp_ = 0;  // the feed's stamp the clock was last set from
+  bool clock_said_ = false;
+  uint64_t ticks_ = 0;      // ticks made (each at a deadline or at --tick's bound)
+  // How late each deadline tick the loop slept for was on the clock
+  // (seconds): the engine thread's wake-up, summarized in the counters as
+  // tick_lag_us (the first 65,536).
+  std::vector<float> tick_lag_;
+  std::chrono::steady_clock::time_point last_tick_{};
   double first_at_ = 0;  // wall clock of the first message (benchmarks compare across processes)
 };
 

@@ -245,6 +245,7 @@ void Pipeline::commit() {
       on_error(io::LineError{pending_where_->number(), 0, why});
       return;
     }
+    if (t <= checker_.clock() && checker_.clock() > last_time_) note_late(t);
     // Timed atoms that change before t: the monitors step to each change
     // with the values before it (a gap in a recording needs no clock).
     for (double c; (c = timed_next_change()) < t; begin = c) {
@@ -301,6 +302,52 @@ void Pipeline::feed_input(uint32_t, std::string_view payload, uint64_t position)
 void Pipeline::feed_logged(uint32_t, std::string_view payload, uint64_t position, double log_time) {
   arrival_ = log_time;
   feed(payload, position);
+}
+
+void Pipeline::note_late(double t) {
+  ++stats_.late_to_clock;
+  if (warned_late_) return;
+  warned_late_ = true;
+  std::fprintf(stderr,
+               "rvc: warning: %s %llu: time %s is not after %s, where the clock's ticks had taken the monitors: checked "
+               "as if at %s (counted as late_to_clock; warned once)\n",
+               options_.position_name.c_str(), static_cast<unsigned long long>(pending_where_->number()),
+               number(t).c_str(), number(checker_.clock()).c_str(), number(checker_.clock()).c_str());
+}
+
+double Pipeline::next_deadline() {
+  if (!ticking()) return std::numeric_limits<double>::infinity();
+  const double d = checker_.robustness() ? checker_.next_deadline_robust(held_margins())
+                                         : checker_.next_deadline(held_values(), bound());
+  return std::min(d, timed_next_change());
+}
+
+void Pipeline::tick(double stream_now) {
+  if (!ticking()) return;
+  // Timed atoms that change by `stream_now` ({@age <= 0.2} falling): the
+  // monitors close [clock, c) with the values before the change, as a
+  // message's step does, and go on from c with the changed ones.
+  for (double c; (c = timed_next_change()) <= stream_now;) {
+    if (c > checker_.clock()) {
+      try {
+        if (checker_.robustness()) checker_.step_robust(checker_.clock(), c, held_margins());
+        else checker_.step(checker_.clock(), c, held_values(), bound());
+      } catch (const engine::data::DataLimitError& e) {
+        throw engine::data::DataLimitError("tick at time " + number(c) + ": " + e.what());
+      }
+    }
+    advance_timed(c);
+  }
+  step_to(stream_now);
+}
+
+void Pipeline::step_to(double instant) {
+  try {
+    if (checker_.robustness()) checker_.tick_robust(instant, held_margins());
+    else checker_.tick(instant, held_values(), bound());
+  } catch (const engine::data::DataLimitError& e) {  // named as a step's error names its message
+    throw engine::data::DataLimitError("tick at time " + number(instant) + ": " + e.what());
+  }
 }
 
 bool Pipeline::oversized(std::string_view payload, uint64_t position) {

@@ -115,7 +115,27 @@ class Pipeline final : public io::JsonlHandler, public Feed {
   void warn(const io::LineError& warning) override { on_warning(warning); }
   uint64_t violations() const override { return checker_.violations(); }
 
+  // Feed: dense time on a clock. Held values are the committed ones (the
+  // last accepted message's, fields it lacked kept from before).
+  double next_deadline() override;
+  void tick(double stream_now) override;
+  double last_stamp() const override {
+    return has_time_ ? last_time_ : std::numeric_limits<double>::quiet_NaN();
+  }
+
  private:
+  // Ticks run only on a checking dense pipeline after its first message:
+  // before it there is no held value, and the timeline's start is 0.
+  bool ticking() const {
+    return has_time_ && !hook_ && !options_.parse_only && checker_.model() == engine::TimeModel::Dense;
+  }
+  // Steps the monitors to `instant` with every field held. The one place a
+  // tick reaches the checker: change instants of other origins (time-driven
+  // atoms) are folded in by stepping to each of them in turn.
+  void step_to(double instant);
+  // A message stamped at or before the instant ticks reached: counted, and
+  // the first one warned about (it is still checked, at that instant).
+  void note_late(double t);
   void report(const std::string& text);
   bool oversized(std::string_view payload, uint64_t position);  // rejects it if so
   void feed_typed(std::string_view sample, uint64_t position);
@@ -151,6 +171,7 @@ class Pipeline final : public io::JsonlHandler, public Feed {
   std::optional<io::Position> pending_where_;
   double last_time_ = 0;
   uint64_t reported_ = 0;
+  bool warned_late_ = false;
   std::vector<std::string> warnings_;  // of the pending message, reported at commit()
   std::string pending_rejection_;      // why the pending message is refused, reported at commit()
   std::string_view pending_text_;      // its text, when options_.on_message wants it

@@ -375,8 +375,14 @@ void SyncedPipeline::on_set(const sync::Member* members, size_t count, double se
              std::to_string(last_time_) + " (dense time needs strictly increasing times; set skipped)");
       return;
     }
+    if (has_time_ && set_stamp <= checker_.clock() && checker_.clock() > last_time_ && late_to_clock_++ == 0)
+      std::fprintf(stderr,
+                   "rvc: warning: set at time %s is not after %s, where the clock's ticks had taken the monitors: "
+                   "checked as if at that instant (counted as late_to_clock; warned once)\n",
+                   stamp_text(set_stamp).c_str(), stamp_text(checker_.clock()).c_str());
     // The set closes [previous time, its time) with the previous values,
-    // stepping first through the instants where timed atoms change.
+    // stepping first through the instants where timed atoms change (those
+    // a tick has already passed were stepped through by it).
     double begin = has_time_ ? last_time_ : 0;
     if (!options_.parse_only) {
       for (double c; (c = timed_next_change()) < set_stamp; begin = c) {
@@ -479,6 +485,25 @@ void SyncedPipeline::idle() {
   if (clocked) policy_->advance(now);
 }
 
+double SyncedPipeline::next_deadline() {
+  if (!ticking()) return std::numeric_limits<double>::infinity();
+  return std::min(checker_.next_deadline(held_values()), timed_next_change());
+}
+
+void SyncedPipeline::tick(double stream_now) {
+  if (!ticking()) return;
+  // Timed atoms that change by `stream_now` ({imu.@age <= 0.1} falling):
+  // the monitors close [clock, c) with the values before the change, as a
+  // set's step does, and go on from c with the changed ones.
+  for (double c; (c = timed_next_change()) <= stream_now;) {
+    if (c > checker_.clock()) checker_.step(checker_.clock(), c, held_values());
+    advance_timed(c);
+  }
+  step_to(stream_now);
+}
+
+void SyncedPipeline::step_to(double instant) { checker_.tick(instant, held_values()); }
+
 void SyncedPipeline::end_of_input() {
   if (ended_) return;
   ended_ = true;
@@ -522,6 +547,7 @@ void SyncedPipeline::finish_report() {
 
 const PipelineStats& SyncedPipeline::stats() const {
   stats_ = PipelineStats{0, sets_rejected_, 0};
+  stats_.late_to_clock = late_to_clock_;
   for (const Input& in : inputs_) {
     stats_.accepted += in.counters.used;
     stats_.rejected += in.pipeline->stats().rejected + in.counters.out_of_order;

@@ -87,6 +87,13 @@ class SyncedPipeline final : public Feed, private sync::Handler {
   uint64_t violations() const override { return checker_.violations(); }
   void finish_report() override;
   void add_stats(io::JsonObject& out) const override;
+  // Dense time on a clock: the held values are the latest set's members'
+  // (combined_), as the next set's step will be given them.
+  double next_deadline() override;
+  void tick(double stream_now) override;
+  double last_stamp() const override {
+    return has_time_ ? last_time_ : std::numeric_limits<double>::quiet_NaN();
+  }
 
   // One payload with its arrival time given (wall-clock seconds): tests and
   // bags (whose arrival is the log time).
@@ -123,6 +130,8 @@ class SyncedPipeline final : public Feed, private sync::Handler {
   void on_release(const sync::Member& message, sync::Release why) override;
   void accept(uint32_t input, const uint8_t* values, double time, uint64_t position);
   void check_health(double now);
+  bool ticking() const { return has_time_ && !options_.parse_only && options_.model == engine::TimeModel::Dense; }
+  void step_to(double instant);  // the one place a tick reaches the checker (see Pipeline::step_to)
   void report(const std::string& text);
   void report_late(const sync::Member& message, double after, bool checked, bool replaced);
 
@@ -142,6 +151,7 @@ class SyncedPipeline final : public Feed, private sync::Handler {
   uint64_t sets_ = 0, sets_rejected_ = 0, reported_ = 0;
   uint64_t late_dropped_ = 0;  // lost: dropped late, or (merge) replaced by a message at the same stamp
   uint64_t late_checked_ = 0, late_reported_ = 0;
+  uint64_t late_to_clock_ = 0;  // sets stamped at or before the instant ticks had reached
   bool has_time_ = false, ended_ = false;
   double last_time_ = 0;
   uint32_t feeding_ = 0;           // the input whose payload is being decoded

@@ -8,6 +8,7 @@
 // once per batch, not once per message, when the engine falls behind.
 #pragma once
 
+#include <chrono>
 #include <condition_variable>
 #include <cstdint>
 #include <mutex>
@@ -51,8 +52,14 @@ class FrameQueue {
   // swaps every queued frame into `batch` (whose first `count` slots are
   // valid). Returns false once closed and drained.
   bool pop_batch(std::vector<OwnedFrame>& batch, size_t& count, int timeout_ms) {
+    return pop_batch_until(batch, count, std::chrono::steady_clock::now() + std::chrono::milliseconds(timeout_ms));
+  }
+  // The same, waiting until a steady-clock instant (a tick's deadline): the
+  // wait ends there to within the kernel's timer slack (tens of
+  // microseconds), not at a polling period's next multiple.
+  bool pop_batch_until(std::vector<OwnedFrame>& batch, size_t& count, std::chrono::steady_clock::time_point until) {
     std::unique_lock<std::mutex> lock(mutex_);
-    not_empty_.wait_for(lock, std::chrono::milliseconds(timeout_ms), [&] { return incoming_count_ > 0 || closed_; });
+    not_empty_.wait_until(lock, until, [&] { return incoming_count_ > 0 || closed_; });
     count = incoming_count_;
     if (count == 0) return !closed_;
     incoming_.swap(batch);
