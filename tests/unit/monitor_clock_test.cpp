@@ -164,6 +164,64 @@ TEST(FeedTicks, SyncedPipelineTicksWithTheLatestSet) {
   EXPECT_EQ(out.back(), (std::pair<double, bool>{0.625, false}));
 }
 
+// Ticks and timing atoms together (issue 26): the publisher of a heartbeat
+// stops after 0.5; {@age <= 0.25} falls at 0.75 (dense: true on [last,
+// last + 0.25), docs/semantics.md) by a tick, with no message after it; the
+// field itself ({alive}) holds true forever, so only the timing atom sees it.
+TEST(FeedTicks, TimingAtomsFallByATickDuringSilence) {
+  Verdicts out;
+  PipelineOptions po;
+  po.model = engine::TimeModel::Dense;
+  Pipeline p({{"p", "{@age <= 0.25} and {alive}"}}, po,
+             [&](const engine::Verdict& v) { out.emplace_back(v.time, v.value); });
+  p.feed(R"({"time":0.25,"alive":true})", 1);
+  p.feed(R"({"time":0.5,"alive":true})", 2);
+  EXPECT_EQ(tick_through(p), (std::vector<double>{0.75}));  // the value at 0.5 is the one already told
+  EXPECT_EQ(out, (Verdicts{{0, false}, {0.25, true}, {0.75, false}}));
+  EXPECT_EQ(p.next_deadline(), INFINITY);  // nothing more can change while silent
+  // The next heartbeat restores it at its own instant, and it falls again
+  // 0.25 later: the timed atoms go on from the tick.
+  p.feed(R"({"time":2,"alive":true})", 3);
+  EXPECT_EQ(tick_through(p), (std::vector<double>{2, 2.25}));
+  EXPECT_EQ(out, (Verdicts{{0, false}, {0.25, true}, {0.75, false}, {2, true}, {2.25, false}}));
+}
+
+// A rate: count[0:1](@arrived) >= 3 with heartbeats at 0.25, 0.5, 0.75 holds
+// from 0.75 until the first leaves the window (t - 1, t] at 1.25, found by a
+// tick while nothing arrives (same instants as `rvc check` on the file).
+TEST(FeedTicks, WindowCountDropsByATickDuringSilence) {
+  Verdicts out;
+  PipelineOptions po;
+  po.model = engine::TimeModel::Dense;
+  Pipeline p({{"p", "{count[0:1](@arrived) >= 3}"}}, po,
+             [&](const engine::Verdict& v) { out.emplace_back(v.time, v.value); });
+  p.feed(R"({"time":0.25})", 1);
+  p.feed(R"({"time":0.5})", 2);
+  p.feed(R"({"time":0.75})", 3);
+  tick_through(p);
+  EXPECT_EQ(out, (Verdicts{{0, false}, {0.75, true}, {1.25, false}}));
+}
+
+// Named inputs: a's age falls by a tick while b goes on delivering until
+// 0.51 and then everything is silent ({a.@age <= 0.25}: a last at 0.5).
+TEST(FeedTicks, SyncedTimingAtomsFallByATick) {
+  Verdicts out;
+  PipelineOptions po;
+  po.model = engine::TimeModel::Dense;
+  SyncOptions so;
+  so.policy = sync::PolicyKind::Merge;
+  SyncedPipeline p({{"p", "{a.@age <= 0.25}"}}, po, {{"a", "test:a", nullptr, ""}, {"b", "test:b", nullptr, ""}},
+                   so, [&](const engine::Verdict& v) { out.emplace_back(v.time, v.value); });
+  p.feed_at(0, R"({"time":0.25})", 1, 0);
+  p.feed_at(1, R"({"time":0.26})", 2, 0);
+  p.feed_at(0, R"({"time":0.5})", 3, 0);
+  p.feed_at(1, R"({"time":0.51})", 4, 0);
+  p.end_of_input();
+  tick_through(p);
+  EXPECT_EQ(out.back(), (std::pair<double, bool>{0.75, false}));
+  EXPECT_EQ(p.next_deadline(), INFINITY);
+}
+
 // Verdict lines, and a signal to the source when one arrives.
 struct Collected {
   std::mutex mu;

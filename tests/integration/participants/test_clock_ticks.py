@@ -38,7 +38,12 @@ PROPERTIES = {
     "alive": "once[0:0.1875]{alive}",           # falls 0.1875 after alive was last true
     "ok": "historically[0:0.3125]{ok}",          # rises 0.3125 after ok turns true
     "run": "{run} since[0:0.4375] {start}",      # falls 0.4375 after start was last true
+    "fresh": "{@age <= 0.25}",                    # a timing atom: falls 0.25 after every last message
 }
+# What Reelay checks for a timing atom: a proposition this test computes itself at every message
+# and heartbeat (dense: true on [last, last + 0.25), docs/semantics.md).
+ORACLE = {"fresh": "{young}"}
+AGE = 0.25
 
 
 def scenario():
@@ -48,14 +53,16 @@ def scenario():
         out.append((0.125 * k, {"alive": k < 8, "ok": True, "run": True, "start": k == 1}, []))
     # stop: alive turned false at 1.0 and silence until 2.0
     out.append((2.0, {"alive": True, "ok": False, "start": True},
-                [("alive", 1.1875, False)]))                      # 1.0 + 0.1875
-    out.append((2.5, {"ok": True, "start": False}, []))            # slow: 2 Hz
+                [("alive", 1.1875, False), ("fresh", 1.25, False)]))   # 1.0 + 0.1875, 1.0 + 0.25
+    out.append((2.5, {"ok": True, "start": False}, [("fresh", 2.25, False)]))  # slow: 2 Hz
     out.append((3.0, {"alive": True}, [("ok", 2.8125, True),        # 2.5 + 0.3125
-                                      ("run", 2.9375, False)]))     # 2.5 + 0.4375
+                                      ("run", 2.9375, False),       # 2.5 + 0.4375
+                                      ("fresh", 2.75, False)]))
     for k in range(1, 21):  # a burst, sent at once
         out.append((3.0 + k * GRID, {"alive": k < 20}, []))
     # stop again: alive false at 3 + 20/1024, silence until 4.0
-    out.append((4.0, {"alive": True, "start": True}, [("alive", 3.0 + 20 * GRID + 0.1875, False)]))
+    out.append((4.0, {"alive": True, "start": True}, [("alive", 3.0 + 20 * GRID + 0.1875, False),
+                                                      ("fresh", 3.0 + 20 * GRID + AGE, False)]))
     for k in range(1, 4):
         out.append((4.0 + 0.125 * k, {"alive": True}, []))
     return out
@@ -73,11 +80,17 @@ def heartbeats(events):
         k += 1
         t = k * GRID
     out = sorted(events + beats, key=lambda e: e["time"])
+    last_message = None
+    for e in out:  # the timing atom, computed here: every stamp and AGE are multiples of GRID
+        if e["time"] in times:
+            last_message = e["time"]
+        e["young"] = last_message is not None and e["time"] - last_message < AGE
     return out
 
 
 def reelay_changes(spec, events):
     m = reelay.dense_timed_monitor(pattern=spec)
+    events = [dict(e) for e in events]
     out = []
     for e in heartbeats(events):
         for r in m.update(dict(e)):
@@ -142,7 +155,7 @@ def check_run(events, collected, stats):
     assert stats["received"] == len(events) == stats["checked"], stats
     last = events[-1]["time"]
     for name, spec in PROPERTIES.items():
-        assert condensed(collected.verdicts, name, last) == reelay_changes(spec, events), name
+        assert condensed(collected.verdicts, name, last) == reelay_changes(ORACLE.get(name, spec), events), name
 
 
 # ---------------------------------------------------------------- Zenoh
