@@ -52,7 +52,8 @@ def test_robustness_of_aggregates_is_value_minus_threshold(rvc, tmp_path):
     # discrete: sum of the last two steps' x (0, 1, 3, 5) minus 5
     r = run(rvc, "check", "--robustness", "--all", "--spec", "{sum[0:1](x) >= 5}", str(trace))
     assert [json.loads(line)["value"] for line in r.stdout.splitlines()] == [-5, -4, -2, 0], r.stderr
-    # dense: max over (t-0.5, t]: 0 on [0,0.25), 1 on [0.25,0.5), 2 on [0.5,1), empty on [1,1.5): -inf
+    # dense: max over (t-0.5, t]: 0 on [0,0.25), 1 on [0.25,0.5), 2 on [0.5,1), empty on [1,1.5): -inf,
+    # and 3 from the last message at 1.5 (told by the end-of-input tick, docs/cli.md "Clocks")
     r = run(rvc, "check", "--robustness", "--dense", "--spec", "{max[0:0.5](x) > 1}", str(trace))
     assert [(json.loads(line)["time"], json.loads(line)["value"]) for line in r.stdout.splitlines()] == \
-        [(0, -1), (0.25, 0), (0.5, 1), (1, "-inf")], r.stdout
+        [(0, -1), (0.25, 0), (0.5, 1), (1, "-inf"), (1.5, 2)], r.stdout
