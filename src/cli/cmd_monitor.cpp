@@ -336,6 +336,7 @@ struct MonitorCommand {
                                      [&](const engine::Verdict& v) { verdicts.put(v); }, on_set);
     start_results(uris, properties);
     runtime::LoopOptions lopts = loop_options(files != 0);
+    clock.open_ros_clock(lopts, transports);
     lopts.input_names = names;
     lopts.input = SyncFlags::joined_names(named);
     record_counters(lopts);
@@ -419,6 +420,7 @@ struct MonitorCommand {
     start_results({input}, properties);
 
     runtime::LoopOptions lopts = loop_options(transport::scheme_of(input) == "file");
+    clock.open_ros_clock(lopts, transports);
     record_counters(lopts);
     attach_health(lopts);
     set_filter(lopts, {input});

@@ -20,6 +20,9 @@ double wall_now() {
   return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
 }
 
+// The /clock input's frames (--clock ros=URI), apart from the checked inputs'.
+constexpr uint32_t kRosClockInput = UINT32_MAX;
+
 // The longest sleep when nothing is due: how soon a stop signal is seen.
 constexpr int kHousekeepingMs = 100;
 
@@ -119,6 +122,10 @@ std::string MonitorLoop::stats_json() const {
   if (options_.filter) out.add("filtered", filtered_);
   if (options_.clock != ClockKind::Off) {
     out.add("clock", to_string(clock_.kind())).add("ticks", ticks_).add("late_to_clock", p.late_to_clock);
+    if (options_.clock == ClockKind::Ros)
+      out.add("clock_messages", clock_messages_)
+          .add("clock_backwards", clock_backwards_)
+          .add("clock_malformed", clock_malformed_);
     if (!tick_lag_.empty()) {  // microseconds from each deadline to the wake-up that ticked it
       std::vector<float> lag = tick_lag_;
       auto at = [&](double q) {
@@ -215,7 +222,8 @@ void MonitorLoop::on_schedule(std::chrono::steady_clock::time_point now) {
 }
 
 void MonitorLoop::follow_stamps(std::chrono::steady_clock::time_point now) {
-  if (options_.clock == ClockKind::Off) return;
+  // Off, or ROS time, which messages do not set (follow_ros_clock).
+  if (options_.clock == ClockKind::Off || options_.clock == ClockKind::Ros) return;
   const double stamp = feed_.last_stamp();
   if (std::isnan(stamp) || (clock_.running() && stamp == clock_stamp_)) return;
   clock_stamp_ = stamp;
@@ -227,6 +235,31 @@ void MonitorLoop::follow_stamps(std::chrono::steady_clock::time_point now) {
                  clock_.reason().empty() ? "" : (clock_.reason() + ")").c_str(),
                  options_.tick_bound > 0 ? " and at least every --tick" : "");
   }
+}
+
+void MonitorLoop::follow_ros_clock(std::string_view payload, std::chrono::steady_clock::time_point now) {
+  ++clock_messages_;
+  double t = 0;
+  std::string error;
+  if (!ros_clock_reader_->read(payload, t, error)) {
+    if (clock_malformed_++ == 0)  // said once: a wrong type would say it 1000 times a second
+      std::fprintf(stderr, "rvc monitor: warning: a /clock message is no rosgraph_msgs/Clock (%s): ignored\n",
+                   error.c_str());
+    return;
+  }
+  const bool was_running = clock_.running();
+  if (!clock_.set_ros_time(t)) {
+    if (clock_backwards_++ == 0)
+      std::fprintf(stderr,
+                   "rvc monitor: warning: /clock went back from %.9g to %.9g s (a simulator reset or a looped bag?): "
+                   "ignored, ROS time stays until /clock passes it again\n",
+                   clock_.now(now), t);
+    return;
+  }
+  if (!was_running)
+    std::fprintf(stderr, "rvc monitor: dense time on the ros clock (/clock, from %.9g s): ticks at the properties' "
+                         "deadlines as /clock passes them\n", t);
+  run_ticks(now, false);
 }
 
 std::chrono::steady_clock::time_point MonitorLoop::run_ticks(std::chrono::steady_clock::time_point now, bool slept) {
@@ -297,10 +330,16 @@ void MonitorLoop::process(const std::vector<transport::Source*>& sources) {
   if (options_.clock != ClockKind::Off) ::prctl(PR_SET_TIMERSLACK, 1000UL, 0, 0, 0);
   if (feed_.reads_in_order()) return process_in_order(sources);
   transport::FrameQueue queue(options_.queue_capacity);
-  Shutdown shutdown(queue, sources);
-  for (size_t i = 0; i < sources.size(); ++i) {
-    const auto input = static_cast<uint32_t>(i);
-    sources[i]->start([&queue, input](const transport::Frame& f) {
+  std::vector<transport::Source*> started = sources;
+  const bool ros_clock = options_.clock == ClockKind::Ros && options_.ros_clock;
+  if (ros_clock) {
+    ros_clock_reader_ = std::make_unique<RosClockReader>(*options_.ros_clock_type);
+    started.push_back(options_.ros_clock);
+  }
+  Shutdown shutdown(queue, started);
+  for (size_t i = 0; i < started.size(); ++i) {
+    const auto input = ros_clock && i == sources.size() ? kRosClockInput : static_cast<uint32_t>(i);
+    started[i]->start([&queue, input](const transport::Frame& f) {
       transport::Frame tagged = f;
       tagged.input = input;
       queue.push(tagged);
@@ -337,6 +376,12 @@ void MonitorLoop::process(const std::vector<transport::Source*>& sources) {
       if (first_at_ == 0) first_at_ = wall_now();
       for (size_t i = 0; i < count; ++i) {
         const transport::OwnedFrame& o = batch[i];
+        if (o.input == kRosClockInput) {
+          // In arrival order with the data: a message after a /clock
+          // message is checked after that clock's ticks.
+          if (!o.eos) follow_ros_clock(o.payload, now);
+          continue;
+        }
         transport::Frame f;
         f.payload = o.payload;
         f.seq = o.seq;

@@ -12,12 +12,14 @@
 #include <chrono>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "runtime/exit_status.hpp"
 #include "runtime/feed.hpp"
 #include "runtime/message_filter.hpp"
+#include "runtime/ros_clock.hpp"
 #include "runtime/stream_clock.hpp"
 #include "runtime/verdict_outputs.hpp"
 #include "transport/endpoint.hpp"
@@ -71,6 +73,11 @@ struct LoopOptions {
   // no message comes, the loop sleeps until the feed's next deadline on
   // this clock and ticks there. Off: the monitors move only with messages.
   ClockKind clock = ClockKind::Off;
+  // ClockKind::Ros: the /clock input and the rosgraph_msgs/Clock type its
+  // samples are read with. Not checked by the properties, not counted as a
+  // checked input: only its own counters (clock_messages, clock_backwards).
+  transport::Source* ros_clock = nullptr;
+  const msg::MessageType* ros_clock_type = nullptr;
   double tick_bound = 0;  // --tick: at most this many seconds between ticks (0: deadlines only)
   // A file input: at its end, a tick at its last stamp reports the last
   // message's own verdicts (as `rvc check` does).
@@ -122,6 +129,9 @@ class MonitorLoop {
   void on_schedule(std::chrono::steady_clock::time_point now);
   // The clock: after a batch (the feed's newest stamp) and on every wake-up.
   void follow_stamps(std::chrono::steady_clock::time_point now);
+  // One /clock message (ClockKind::Ros): moves the clock and ticks through
+  // every deadline it reached.
+  void follow_ros_clock(std::string_view payload, std::chrono::steady_clock::time_point now);
   // Ticks at every deadline the clock has reached (and at --tick's bound);
   // returns when the next tick is due (steady max: none). `slept`: the wait
   // ended with no message (at a deadline, or a duty).
@@ -152,6 +162,8 @@ class MonitorLoop {
   StreamClock clock_{ClockKind::Off};
   double clock_stamp_ = 0;  // the feed's stamp the clock was last set from
   bool clock_said_ = false;
+  std::unique_ptr<RosClockReader> ros_clock_reader_;
+  uint64_t clock_messages_ = 0, clock_backwards_ = 0, clock_malformed_ = 0;
   uint64_t ticks_ = 0;      // ticks made (each at a deadline or at --tick's bound)
   // How late each deadline tick the loop slept for was on the clock
   // (seconds): the engine thread's wake-up, summarized in the counters as

@@ -15,6 +15,7 @@ const char* to_string(ClockKind kind) {
     case ClockKind::Auto: return "auto";
     case ClockKind::Wall: return "wall";
     case ClockKind::Stamps: return "stamps";
+    case ClockKind::Ros: return "ros";
   }
   return "unknown";
 }
@@ -32,7 +33,8 @@ TimeSource TimeSource::system() {
 }
 
 void StreamClock::on_message(double stamp, Steady::time_point at) {
-  if (kind_ == ClockKind::Off || std::isnan(stamp)) return;
+  // ROS time is /clock's alone: messages do not set it.
+  if (kind_ == ClockKind::Off || kind_ == ClockKind::Ros || std::isnan(stamp)) return;
   if (kind_ == ClockKind::Auto) {
     const bool epoch = std::fabs(stamp - time_.wall()) <= kEpochTolerance;
     kind_ = epoch ? ClockKind::Wall : ClockKind::Stamps;
@@ -44,13 +46,24 @@ void StreamClock::on_message(double stamp, Steady::time_point at) {
   at_ = at;
 }
 
+bool StreamClock::set_ros_time(double t) {
+  if (kind_ != ClockKind::Ros || !std::isfinite(t) || (running_ && t < stamp_)) return false;
+  running_ = true;
+  stamp_ = t;
+  return true;
+}
+
 double StreamClock::now(Steady::time_point at) const {
+  if (kind_ == ClockKind::Ros) return stamp_;  // stands still between /clock messages
   if (kind_ == ClockKind::Wall) return time_.wall() + seconds(at - time_.steady());
   return stamp_ + seconds(at - at_);
 }
 
 StreamClock::Steady::time_point StreamClock::when(double t, Steady::time_point at) const {
   if (!running_ || !(t < INFINITY)) return Steady::time_point::max();
+  // ROS time does not run on this host's clock: a deadline is reached when
+  // /clock passes it, and no sleep can bring that on.
+  if (kind_ == ClockKind::Ros) return t <= stamp_ ? at : Steady::time_point::max();
   const double ahead = t - now(at);  // seconds of stream time still to go
   // Within a microsecond counts as reached: the wall clock and the steady
   // clock are read one after the other, and a wake-up at the rounded

@@ -10,6 +10,9 @@
 //   auto    wall if the first stamp is within kEpochTolerance of the system
 //           clock, else stamps.
 //   off     no ticks: the monitors move only with messages.
+//   ros     ROS time (`use_sim_time`): the latest /clock value
+//           (rosgraph_msgs/Clock), set by set_ros_time; it moves only when
+//           /clock does, at whatever speed a simulator or a bag replay runs.
 //
 // Before the first stamped message the clock does not run: the timeline
 // starts at 0, and there is nothing held to tick with.
@@ -22,9 +25,10 @@
 
 namespace rvc::runtime {
 
-enum class ClockKind { Off, Auto, Wall, Stamps };
+enum class ClockKind { Off, Auto, Wall, Stamps, Ros };
 const char* to_string(ClockKind kind);
-// "auto", "wall", "stamps", "off"; nullopt for anything else.
+// "auto", "wall", "stamps", "off"; nullopt for anything else ("ros" comes
+// with its /clock input: ros=URI, parsed by the command).
 std::optional<ClockKind> parse_clock(const std::string& text);
 
 // Where the clock reads the time; a fake one in tests.
@@ -48,6 +52,10 @@ class StreamClock {
   // The monitors took a message stamped `stamp` (NaN: none); it arrived at
   // steady instant `at`. The first one settles auto.
   void on_message(double stamp, Steady::time_point at);
+  // Ros: /clock said `t`. False (and ignored) for a time before the
+  // current one: a simulator reset or a bag replayed in a loop must not
+  // move the monitors back; an equal time is no change.
+  bool set_ros_time(double t);
   // Wall or Stamps, once a message was taken (Off and Auto until then).
   ClockKind kind() const { return kind_; }
   bool running() const { return running_; }
@@ -63,7 +71,7 @@ class StreamClock {
   ClockKind kind_;
   TimeSource time_;
   bool running_ = false;
-  double stamp_ = 0;        // stamps: the last message's
+  double stamp_ = 0;        // stamps: the last message's; ros: the latest /clock
   Steady::time_point at_;   // ... and its arrival
   std::string reason_;
 };

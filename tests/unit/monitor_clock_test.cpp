@@ -15,8 +15,11 @@
 #include <thread>
 #include <vector>
 
+#include "io/cdr_codec.hpp"
+#include "msg/type_registry.hpp"
 #include "runtime/monitor_loop.hpp"
 #include "runtime/pipeline.hpp"
+#include "runtime/ros_clock.hpp"
 #include "runtime/stream_clock.hpp"
 #include "runtime/synced_pipeline.hpp"
 #include "runtime/verdict_outputs.hpp"
@@ -97,7 +100,53 @@ TEST(StreamClock, ParsesItsNames) {
   EXPECT_EQ(parse_clock("stamps"), ClockKind::Stamps);
   EXPECT_EQ(parse_clock("auto"), ClockKind::Auto);
   EXPECT_EQ(parse_clock("off"), ClockKind::Off);
-  EXPECT_FALSE(parse_clock("ros").has_value());
+  EXPECT_FALSE(parse_clock("ros").has_value());  // ros=URI: the command parses it
+}
+
+// ROS time (use_sim_time) is the latest /clock value: it stands still
+// between /clock messages, whatever the host's clocks do; a deadline is
+// reached when /clock passes it (never by sleeping); a /clock going back is
+// refused; stamps of messages do not move it.
+TEST(StreamClock, RosTimeIsTheLatestClockValue) {
+  FakeTime t;
+  StreamClock c(ClockKind::Ros, t.source());
+  c.on_message(5.0, t.steady);  // a message's stamp: not ROS time
+  EXPECT_FALSE(c.running());
+  EXPECT_EQ(c.when(0.0, t.steady), Steady::time_point::max());  // before the first /clock nothing ticks
+  ASSERT_TRUE(c.set_ros_time(2.0));
+  ASSERT_TRUE(c.running());
+  t.advance(100);  // an hour of host time changes nothing
+  EXPECT_EQ(c.now(t.steady), 2.0);
+  EXPECT_EQ(c.when(1.5, t.steady), t.steady);  // passed: due now
+  EXPECT_EQ(c.when(2.0, t.steady), t.steady);  // reached exactly: due now
+  EXPECT_EQ(c.when(2.0 + 1e-9, t.steady), Steady::time_point::max());  // only /clock can bring it
+  EXPECT_FALSE(c.set_ros_time(1.0));  // backwards (a reset, a looped bag): ignored
+  EXPECT_EQ(c.now(t.steady), 2.0);
+  EXPECT_TRUE(c.set_ros_time(2.0));  // the same time again: no harm
+  EXPECT_TRUE(c.set_ros_time(3.5));
+  EXPECT_EQ(c.when(3.0, t.steady), t.steady);
+  EXPECT_FALSE(StreamClock(ClockKind::Wall, t.source()).set_ros_time(1.0));  // only the ros clock takes /clock
+}
+
+// A /clock sample: typed CDR (as ROS 2 publishes it on DDS or rmw_zenoh) or
+// JSON (a Time or seconds, as `rvc echo` prints it); anything else refused.
+TEST(RosClockReader, ReadsCdrAndJsonClocks) {
+  msg::TypeRegistry registry;
+  const msg::MessageType& type = registry.resolve("rosgraph_msgs/msg/Clock");
+  RosClockReader reader(type);
+  std::string cdr, error;
+  ASSERT_TRUE(io::json_to_cdr(type, R"({"clock":{"sec":3,"nanosec":500000000}})", cdr, error)) << error;
+  ASSERT_EQ(cdr.size(), 12u);  // header, int32 sec, uint32 nanosec
+  double t = 0;
+  ASSERT_TRUE(reader.read(cdr, t, error)) << error;
+  EXPECT_EQ(t, 3.5);
+  ASSERT_TRUE(reader.read(R"({"clock":{"sec":7,"nanosec":250000000}})", t, error)) << error;
+  EXPECT_EQ(t, 7.25);
+  ASSERT_TRUE(reader.read(R"({"clock":2.125})", t, error)) << error;
+  EXPECT_EQ(t, 2.125);
+  EXPECT_FALSE(reader.read(R"({"time":1})", t, error));
+  EXPECT_FALSE(reader.read("not json", t, error));
+  EXPECT_FALSE(reader.read(std::string("\0\1\0\0\3", 5), t, error));  // a truncated sample
 }
 
 using Verdicts = std::vector<std::pair<double, bool>>;
@@ -383,6 +432,85 @@ TEST(MonitorLoopClock, CountsMessagesLateToTheClock) {
   EXPECT_TRUE(r.seen_before_resume);
   EXPECT_NE(r.stats.find(R"("late_to_clock":1)"), std::string::npos) << r.stats;
   EXPECT_NE(r.stats.find(R"("checked":3)"), std::string::npos) << r.stats;
+}
+
+// A scripted /clock publisher: once `start_after` is out (the data are in),
+// publishes `times` as JSON Clock messages at once, much faster than real
+// time.
+class ClockSource final : public transport::Source {
+ public:
+  ClockSource(Collected& c, std::string start_after, std::vector<double> times)
+      : c_(c), start_after_(std::move(start_after)), times_(std::move(times)) {}
+  ~ClockSource() override { stop(); }
+  void start(transport::FrameHandler handler) override {
+    thread_ = std::thread([this, handler] {
+      {
+        std::unique_lock lock(c_.mu);
+        if (!c_.changed.wait_for(lock, 5s, [&] { return c_.has(start_after_) || stopping_; })) return;
+        if (stopping_) return;
+      }
+      for (double t : times_) {
+        transport::Frame f;
+        const std::string payload = R"({"clock":)" + std::to_string(t) + "}";
+        f.payload = payload;
+        handler(f);
+      }
+    });
+  }
+  void stop() override {
+    {
+      std::lock_guard lock(c_.mu);
+      stopping_ = true;
+      c_.changed.notify_all();
+    }
+    if (thread_.joinable()) thread_.join();
+  }
+
+ private:
+  Collected& c_;
+  std::string start_after_;
+  std::vector<double> times_;
+  bool stopping_ = false;
+  std::thread thread_;
+};
+
+// --clock ros: alive until 1.0, then silence while /clock runs from 0 to 10
+// (at once: far faster than real time) and goes back to 2 (a reset). The
+// fall of once[0:2]{alive} at 3.0 (by hand: alive holds on [0.5, 1.0), so
+// the window [t-2, t] holds a true instant until t = 3.0) is published
+// while the data source is still silent; /clock is no checked input.
+TEST(MonitorLoopClock, RosClockTicksAsClockPassesDeadlines) {
+  Collected collected;
+  std::vector<std::unique_ptr<transport::Sink>> sinks;
+  sinks.push_back(std::make_unique<CollectingSink>(collected));
+  VerdictOutputs outputs(std::move(sinks), false);
+  PipelineOptions po;
+  po.model = engine::TimeModel::Dense;
+  po.position_name = "seq";
+  Pipeline pipeline({{"p", "once[0:2]{alive}"}}, po, [&](const engine::Verdict& v) { outputs.put(v); });
+  msg::TypeRegistry registry;
+  LoopOptions lo;
+  lo.input = "test";
+  lo.exit_on_eos = true;
+  lo.clock = ClockKind::Ros;
+  lo.ros_clock_type = &registry.resolve("rosgraph_msgs/msg/Clock");
+  std::vector<double> times;
+  for (int i = 0; i <= 20; ++i) times.push_back(i * 0.5);
+  times.push_back(2.0);
+  // The data's first verdict is out once the second message is taken.
+  ClockSource clock(collected, R"({"time":0.5,"property":"p","value":true})", times);
+  lo.ros_clock = &clock;
+  MonitorLoop loop(pipeline, outputs, nullptr, lo);
+  SilentSource data(collected, {R"({"time":0.5,"alive":true})", R"({"time":1,"alive":false})"},
+                    R"({"time":3,"property":"p","value":false})", {R"({"time":11,"alive":true})"}, 5s);
+  loop.run(data);
+  EXPECT_TRUE(data.seen_before_resume) << "the fall at 3.0 was not published while only /clock moved";
+  const std::string stats = loop.final_stats();
+  EXPECT_NE(stats.find(R"("clock":"ros")"), std::string::npos) << stats;
+  EXPECT_NE(stats.find(R"("checked":3)"), std::string::npos) << stats;  // /clock is not checked
+  EXPECT_NE(stats.find(R"("received":3)"), std::string::npos) << stats;
+  EXPECT_NE(stats.find(R"("clock_messages":22)"), std::string::npos) << stats;
+  EXPECT_NE(stats.find(R"("clock_backwards":1)"), std::string::npos) << stats;
 }
 
 }  // namespace
