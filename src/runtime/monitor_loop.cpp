@@ -372,16 +372,19 @@ void MonitorLoop::process(const std::vector<transport::Source*>& sources) {
         break;
       }
     } else {
-      last_message = batch_at_ = now;
-      if (first_at_ == 0) first_at_ = wall_now();
+      batch_at_ = now;
       for (size_t i = 0; i < count; ++i) {
         const transport::OwnedFrame& o = batch[i];
         if (o.input == kRosClockInput) {
           // In arrival order with the data: a message after a /clock
-          // message is checked after that clock's ticks.
+          // message is checked after that clock's ticks. /clock is no
+          // data: a simulator's clock running on does not hold off
+          // --idle-timeout while the checked inputs are silent.
           if (!o.eos) follow_ros_clock(o.payload, now);
           continue;
         }
+        last_message = now;
+        if (first_at_ == 0) first_at_ = wall_now();
         transport::Frame f;
         f.payload = o.payload;
         f.seq = o.seq;

@@ -229,6 +229,45 @@ def test_zenoh_ros_clock_takes_cdr_and_json(rvc, tmp_path):
         net.close()
 
 
+def test_clock_messages_do_not_hold_off_the_idle_timeout(rvc, tmp_path):
+    """/clock is no data: a simulator whose clock runs on while the checked input is silent does not
+    keep the monitor alive past --idle-timeout (it ends by idle-timeout while /clock is published)."""
+    if "zenoh" not in transports_built(rvc):
+        pytest.skip("rvc built without Zenoh")
+    zenoh = pytest.importorskip("zenoh")
+    net = ZenohNet(rvc, via_router=False)
+    key, ckey = "rvc/rosclock_idle/in", "rvc/rosclock_idle/clock"
+    mon = subprocess.Popen([rvc, "monitor", "--dense", "--clock", f"ros=zenoh:{ckey}", "--spec", "once[0:2]{alive}",
+                            "--input", f"zenoh:{key}", "--idle-timeout", "1", *net.monitor],
+                           stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    try:
+        time.sleep(0.3)
+        s = zsession(zenoh, **net.py)
+        pub, cpub = s.declare_publisher(key), s.declare_publisher(ckey)
+        wait_for(lambda: all(getattr(p.matching_status, "matching", False) for p in (pub, cpub)),
+                 "rvc monitor to match")
+        pub.put(json.dumps({"time": 0.5, "alive": True}), attachment=struct.pack("<QB", 1, 0))
+        k = 0
+        deadline = time.monotonic() + HANG_GUARD
+        while mon.poll() is None and time.monotonic() < deadline:  # /clock on, data silent
+            k += 1
+            cpub.put(json.dumps({"clock": k * 0.01}))
+            time.sleep(0.01)
+        still_running = mon.poll() is None
+        s.close()
+        if still_running:
+            mon.kill()
+        _, err = mon.communicate(timeout=30)
+        assert not still_running, "the monitor did not end by --idle-timeout while /clock ran on"
+        assert "ended by idle-timeout" in err or '"received":1' in err, err
+        stats = json.loads(err.strip().splitlines()[-1])
+        assert stats["received"] == 1 == stats["checked"] and stats["clock_messages"] >= 1, stats
+    finally:
+        if mon.poll() is None:
+            mon.kill()
+        net.close()
+
+
 @pytest.mark.parametrize("value, why", [
     ("ros=", "not an empty URI"),
     ("ros=mcap:x.mcap", "not 'mcap:x.mcap'"),
