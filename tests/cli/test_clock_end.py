@@ -39,6 +39,7 @@ def write_bag(tmp_path, ts):
     return str(next(folder.glob("*.mcap")))
 
 
+@pytest.mark.needs_rust  # the MCAP reader is in the Rust library
 def test_bag_end_tick_reports_a_fall_after_the_topics_last_message(rvc, tmp_path, typestore):  # noqa: F811
     bag = write_bag(tmp_path, typestore)
     args = [rvc, "check", "--dense", "--topic", GEAR_TOPIC, "--spec", "once[0:0.5]{report == 2}",
@@ -55,6 +56,7 @@ def test_bag_end_tick_reports_a_fall_after_the_topics_last_message(rvc, tmp_path
     assert verdicts(off.stdout) == [("p1", 0, False), ("p2", 0, False), ("p1", 0.25, True), ("p2", 0.25, True)]
 
 
+@pytest.mark.needs_rust  # the MCAP reader is in the Rust library
 def test_bag_end_tick_through_rvc_monitor(rvc, tmp_path, typestore):  # noqa: F811
     bag = write_bag(tmp_path, typestore)
     got = run([rvc, "monitor", "--dense", "--input", f"mcap:{bag}", "--topic", GEAR_TOPIC,
