@@ -48,6 +48,9 @@ def host_zenoh_lib():
     of compiling the crate a second time (RVC_IMAGE_ZENOH=source forces the full in-image build)."""
     if os.environ.get("RVC_IMAGE_ZENOH") == "source" or not os.environ.get("RVC_BIN"):
         return None
+    lib = os.environ.get("RVC_ZENOH_LIB")  # set by tests/CMakeLists.txt: where this build put it
+    if lib:
+        return lib if os.path.isfile(lib) else None
     target = os.environ.get("RVC_CARGO_TARGET_DIR") or os.path.join(os.path.dirname(os.environ["RVC_BIN"]), "cargo-target")
     lib = os.path.join(target, "release", "librvc_zenoh.a")
     return lib if os.path.isfile(lib) else None
