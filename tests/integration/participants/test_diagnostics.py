@@ -21,6 +21,7 @@ import time
 import pytest
 
 from conftest import transports_built
+from ros_idl_types import loopback_dds, ros_idl_types
 from rvc_testlib import dds_matched
 from test_python_peers import HANG_GUARD, free_port, wait_for, zsession
 
@@ -53,54 +54,15 @@ def check_violated(st, name, received_at_least):
 
 def diagnostic_idl_types():
     """DiagnosticArray and std_msgs/String as cyclonedds IdlStructs, as rosidl maps the .msg files."""
-    from dataclasses import dataclass
-
-    from cyclonedds.idl import IdlStruct
-    from cyclonedds.idl.types import int32, sequence, uint8, uint32
-
-    @dataclass
-    class Time_(IdlStruct, typename="builtin_interfaces::msg::dds_::Time_"):
-        sec: int32
-        nanosec: uint32
-
-    @dataclass
-    class Header_(IdlStruct, typename="std_msgs::msg::dds_::Header_"):
-        stamp: Time_
-        frame_id: str
-
-    @dataclass
-    class KeyValue_(IdlStruct, typename="diagnostic_msgs::msg::dds_::KeyValue_"):
-        key: str
-        value: str
-
-    @dataclass
-    class DiagnosticStatus_(IdlStruct, typename="diagnostic_msgs::msg::dds_::DiagnosticStatus_"):
-        level: uint8
-        name: str
-        message: str
-        hardware_id: str
-        values: sequence[KeyValue_]
-
-    @dataclass
-    class DiagnosticArray_(IdlStruct, typename="diagnostic_msgs::msg::dds_::DiagnosticArray_"):
-        header: Header_
-        status: sequence[DiagnosticStatus_]
-
-    @dataclass
-    class String_(IdlStruct, typename="std_msgs::msg::dds_::String_"):
-        data: str
-
-    return DiagnosticArray_, String_
+    t = ros_idl_types()
+    return t.DiagnosticArray_, t.String_
 
 
 @pytest.fixture
 def dds_types(rvc, tmp_path, monkeypatch):
     if "dds" not in transports_built(rvc):
         pytest.skip("rvc built without DDS")
-    cfg = tmp_path / "cyclonedds.xml"
-    subprocess.run([rvc, "dds-config", "-o", str(cfg)], check=True)
-    assert 'name="lo"' in cfg.read_text()
-    monkeypatch.setenv("CYCLONEDDS_URI", f"file://{cfg}")  # before any Python participant exists
+    loopback_dds(rvc, tmp_path, monkeypatch)  # before any Python participant exists
     pytest.importorskip("cyclonedds")
     return diagnostic_idl_types()
 

@@ -16,6 +16,7 @@ import time
 import pytest
 
 from conftest import transports_built
+from ros_idl_types import loopback_dds, ros_idl_types
 from rvc_testlib import dds_matched
 from test_python_peers import HANG_GUARD, dds_qos, free_port, wait_for, zsession
 
@@ -61,45 +62,10 @@ def check_run(mon, arrays, topic, last_sent_stamp):
 def dds_types(rvc, tmp_path, monkeypatch):
     if "dds" not in transports_built(rvc):
         pytest.skip("rvc built without DDS")
-    cfg = tmp_path / "cyclonedds.xml"
-    subprocess.run([rvc, "dds-config", "-o", str(cfg)], check=True)
-    assert 'name="lo"' in cfg.read_text()
-    monkeypatch.setenv("CYCLONEDDS_URI", f"file://{cfg}")  # before any Python participant exists
+    loopback_dds(rvc, tmp_path, monkeypatch)  # before any Python participant exists
     pytest.importorskip("cyclonedds")
-    from dataclasses import dataclass
-
-    from cyclonedds.idl import IdlStruct
-    from cyclonedds.idl.types import int32, sequence, uint8, uint32
-
-    @dataclass
-    class Time_(IdlStruct, typename="builtin_interfaces::msg::dds_::Time_"):
-        sec: int32
-        nanosec: uint32
-
-    @dataclass
-    class Header_(IdlStruct, typename="std_msgs::msg::dds_::Header_"):
-        stamp: Time_
-        frame_id: str
-
-    @dataclass
-    class KeyValue_(IdlStruct, typename="diagnostic_msgs::msg::dds_::KeyValue_"):
-        key: str
-        value: str
-
-    @dataclass
-    class DiagnosticStatus_(IdlStruct, typename="diagnostic_msgs::msg::dds_::DiagnosticStatus_"):
-        level: uint8  # `byte` in the .msg: one octet on the wire
-        name: str
-        message: str
-        hardware_id: str
-        values: sequence[KeyValue_]
-
-    @dataclass
-    class DiagnosticArray_(IdlStruct, typename="diagnostic_msgs::msg::dds_::DiagnosticArray_"):
-        header: Header_
-        status: sequence[DiagnosticStatus_]
-
-    return Time_, Header_, DiagnosticArray_
+    t = ros_idl_types()
+    return t.Time_, t.Header_, t.DiagnosticArray_
 
 
 def test_dds_topic_goes_ok_then_timeout_on_diagnostics(rvc, dds_types):
