@@ -13,7 +13,8 @@ def loopback_dds(rvc, tmp_path, monkeypatch):
     name `lo`), before any participant exists."""
     cfg = tmp_path / "cyclonedds.xml"
     subprocess.run([rvc, "dds-config", "-o", str(cfg)], check=True)
-    assert 'name="lo"' in cfg.read_text()
+    xml = cfg.read_text()
+    assert 'name="lo"' in xml and "<AllowMulticast>false</AllowMulticast>" in xml
     monkeypatch.setenv("CYCLONEDDS_URI", f"file://{cfg}")
 
 
@@ -55,5 +56,9 @@ def ros_idl_types():
     class String_(IdlStruct, typename="std_msgs::msg::dds_::String_"):
         data: str
 
+    @dataclass
+    class Clock_(IdlStruct, typename="rosgraph_msgs::msg::dds_::Clock_"):
+        clock: Time_
+
     return SimpleNamespace(Time_=Time_, Header_=Header_, KeyValue_=KeyValue_, DiagnosticStatus_=DiagnosticStatus_,
-                           DiagnosticArray_=DiagnosticArray_, String_=String_)
+                           DiagnosticArray_=DiagnosticArray_, String_=String_, Clock_=Clock_)

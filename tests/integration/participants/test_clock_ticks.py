@@ -26,6 +26,7 @@ import time
 import pytest
 
 from conftest import transports_built
+from ros_idl_types import loopback_dds, ros_idl_types
 from rvc_testlib import dds_matched
 from test_python_peers import ZenohNet, dds_qos, free_port, wait_for, zsession  # noqa: F401 (fixtures below)
 
@@ -226,20 +227,9 @@ def test_zenoh_without_a_clock_silences_wait_for_the_next_message(rvc, tmp_path,
 def dds_env(rvc, tmp_path, monkeypatch):
     if "dds" not in transports_built(rvc):
         pytest.skip("rvc built without DDS")
-    cfg = tmp_path / "cyclonedds.xml"
-    subprocess.run([rvc, "dds-config", "-o", str(cfg)], check=True)
-    xml = cfg.read_text()
-    assert 'name="lo"' in xml and "<AllowMulticast>false</AllowMulticast>" in xml
-    monkeypatch.setenv("CYCLONEDDS_URI", f"file://{cfg}")  # before any Python participant exists
+    loopback_dds(rvc, tmp_path, monkeypatch)  # before any Python participant exists
     pytest.importorskip("cyclonedds")
-    from dataclasses import dataclass
-    from cyclonedds.idl import IdlStruct
-
-    @dataclass
-    class String_(IdlStruct, typename="std_msgs::msg::dds_::String_"):
-        data: str
-
-    return String_
+    return ros_idl_types().String_
 
 
 def test_dds_silences_are_reported_before_the_publisher_resumes(rvc, tmp_path, dds_env):

@@ -25,6 +25,7 @@ import time
 import pytest
 
 from conftest import transports_built
+from ros_idl_types import loopback_dds, ros_idl_types
 from rvc_testlib import dds_matched
 from test_python_peers import ZenohNet, dds_qos, wait_for, zsession
 
@@ -39,31 +40,10 @@ CLOCK_END = 25.0
 def ros_types(rvc, tmp_path, monkeypatch):
     if "dds" not in transports_built(rvc):
         pytest.skip("rvc built without DDS")
-    cfg = tmp_path / "cyclonedds.xml"
-    subprocess.run([rvc, "dds-config", "-o", str(cfg)], check=True)
-    xml = cfg.read_text()
-    assert 'name="lo"' in xml and "<AllowMulticast>false</AllowMulticast>" in xml
-    monkeypatch.setenv("CYCLONEDDS_URI", f"file://{cfg}")  # before any Python participant exists
+    loopback_dds(rvc, tmp_path, monkeypatch)  # before any Python participant exists
     pytest.importorskip("cyclonedds")
-    from dataclasses import dataclass
-
-    from cyclonedds.idl import IdlStruct
-    from cyclonedds.idl.types import int32, uint32
-
-    @dataclass
-    class String_(IdlStruct, typename="std_msgs::msg::dds_::String_"):
-        data: str
-
-    @dataclass
-    class Time_(IdlStruct, typename="builtin_interfaces::msg::dds_::Time_"):
-        sec: int32
-        nanosec: uint32
-
-    @dataclass
-    class Clock_(IdlStruct, typename="rosgraph_msgs::msg::dds_::Clock_"):
-        clock: Time_
-
-    return String_, Time_, Clock_
+    t = ros_idl_types()
+    return t.String_, t.Time_, t.Clock_
 
 
 class Collected:
