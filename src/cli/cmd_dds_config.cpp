@@ -4,11 +4,13 @@
 // CYCLONEDDS_URI=file://...
 #include <cstdio>
 #include <memory>
+#include <stdexcept>
 #include <string>
 
 #include "cli/commands.hpp"
 #include "cli/transport_flags.hpp"
 #include "transport/dds/dds_options.hpp"
+#include "transport/output_file.hpp"
 
 namespace rvc::cli {
 
@@ -23,10 +25,14 @@ Runner register_dds_config(CLI::App& app) {
   sub->add_option("--output,-o", cmd->output, "File to write (- for stdout)")->capture_default_str();
   return [cmd] {
     std::string xml = transport::dds::generated_config_xml(cmd->dds);
-    std::FILE* out = cmd->output == "-" ? stdout : std::fopen(cmd->output.c_str(), "w");
-    if (!out) {
-      std::fprintf(stderr, "rvc: cannot write '%s'\n", cmd->output.c_str());
-      return static_cast<int>(kUsage);
+    std::FILE* out = stdout;
+    if (cmd->output != "-") {
+      try {
+        out = transport::open_output_file(cmd->output, "--output");
+      } catch (const std::invalid_argument& e) {
+        std::fprintf(stderr, "rvc: %s\n", e.what());
+        return static_cast<int>(kUsage);
+      }
     }
     std::fputs(xml.c_str(), out);
     if (out != stdout) std::fclose(out);

@@ -1,9 +1,11 @@
 // rvc timescales: generate a Timescales benchmark trace and its formula.
 #include <cstdio>
 #include <memory>
+#include <stdexcept>
 
 #include "cli/commands.hpp"
 #include "tools/timescales.hpp"
+#include "transport/output_file.hpp"
 
 namespace rvc::cli {
 namespace {
@@ -32,9 +34,11 @@ struct TimescalesCommand {
       return kOk;
     }
     if (!properties_out.empty()) {
-      std::FILE* f = std::fopen(properties_out.c_str(), "w");
-      if (!f) {
-        std::fprintf(stderr, "rvc: cannot write '%s'\n", properties_out.c_str());
+      std::FILE* f = nullptr;
+      try {
+        f = transport::open_output_file(properties_out, "--properties-out");
+      } catch (const std::invalid_argument& e) {
+        std::fprintf(stderr, "rvc: %s\n", e.what());
         return kUsage;
       }
       std::fprintf(f, "properties:\n  - name: %s%lld\n    spec: \"%s\"\n", opts.family.c_str(),
@@ -43,9 +47,10 @@ struct TimescalesCommand {
     }
     std::FILE* out = stdout;
     if (output != "-") {
-      out = std::fopen(output.c_str(), "w");
-      if (!out) {
-        std::fprintf(stderr, "rvc: cannot write '%s'\n", output.c_str());
+      try {
+        out = transport::open_output_file(output, "--output");
+      } catch (const std::invalid_argument& e) {
+        std::fprintf(stderr, "rvc: %s\n", e.what());
         return kUsage;
       }
     }

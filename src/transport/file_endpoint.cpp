@@ -1,5 +1,7 @@
 #include "transport/file_endpoint.hpp"
 
+#include "transport/output_file.hpp"
+
 #include <fcntl.h>
 #include <poll.h>
 #include <unistd.h>
@@ -109,10 +111,9 @@ FileSink::FileSink(std::string path) : path_(std::move(path)) {
     file_ = stdout;
     line_buffered_ = isatty(1);
   } else {
-    file_ = std::fopen(path_.c_str(), "w");
+    file_ = open_output_file(path_);  // refuses a file rvc did not write
     owned_ = true;
   }
-  if (!file_) throw std::invalid_argument("cannot open '" + path_ + "' for writing: " + std::strerror(errno));
 }
 
 FileSink::~FileSink() {

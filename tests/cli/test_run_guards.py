@@ -132,12 +132,71 @@ def test_check_from_stdin_refuses_to_write_over_it(rvc, tmp_path):
             r = run([rvc, "monitor", "--spec", "{ok}", "--input", "-", "--output", f"file:{out}"], stdin=stdin)
         assert r.returncode == 2 and "would be read back" in r.stderr, r.stderr
         assert trace.read_text() == text
-    # another file on stdin: fine
-    other = tmp_path / "other.jsonl"
-    other.write_text(text)
-    with open(other) as stdin:
-        r = run([rvc, "check", "--spec", "{ok}", "-", "-o", str(trace)], stdin=stdin)
+    # another file on stdin, into a new output: fine
+    with open(trace) as stdin:
+        r = run([rvc, "check", "--spec", "{ok}", "-", "-o", str(tmp_path / "verdicts.jsonl")], stdin=stdin)
     assert r.returncode == 1, r.stderr
+
+
+# ---- file outputs write over only what rvc wrote ----
+
+PRECIOUS = "precious: not rvc's\n"
+
+
+def _file_output_commands(rvc, tmp_path, out):
+    """Every way of naming a file to write, each with the file `out`."""
+    trace = write(tmp_path / "in.jsonl", [{"time": 0, "ok": True}, {"time": 1, "ok": False}])
+    cmds = [
+        [rvc, "check", "--spec", "{ok}", trace, "-o", out],
+        [rvc, "monitor", "--spec", "{ok}", "--input", f"file:{trace}", "--output", f"file:{out}"],
+        [rvc, "monitor", "--spec", "{ok}", "--input", f"file:{trace}", "--output", "file:/dev/null",
+         "--diagnostics", f"file:{out}"],
+        [rvc, "monitor", "--spec", "{ok}", "--input", f"file:{trace}", "--output", "file:/dev/null",
+         "--stats-output", f"file:{out}"],
+        [rvc, "monitor", "--spec", "{ok}", "--input", f"file:{trace}", "--output", "file:/dev/null",
+         "--on-violation", f'p1=file:{out}:{{"stop":true}}'],
+        [rvc, "hz", f"file:{trace}", "--time-source", "stamps", "--diagnostics", f"file:{out}"],
+        [rvc, "replay", trace, "--to", f"file:{out}"],
+        [rvc, "timescales", "AlwaysBQR", "--ubound", "3", "--duration", "10", "-o", out],
+        [rvc, "timescales", "AlwaysBQR", "--ubound", "3", "--duration", "10", "--properties-out", out],
+    ]
+    if "dds" in transports_built(rvc):
+        cmds.append([rvc, "dds-config", "-o", out])
+    return cmds
+
+
+def test_a_file_rvc_did_not_write_is_never_written_over(rvc, tmp_path):
+    precious = tmp_path / "precious.txt"
+    for cmd in _file_output_commands(rvc, tmp_path, str(precious)):
+        precious.write_text(PRECIOUS)
+        r = run(cmd)
+        assert r.returncode == 2, (cmd, r.returncode, r.stderr)
+        assert f"'{precious}': it exists and rvc did not write it: refusing to write over it" in r.stderr, \
+            (cmd, r.stderr)
+        assert precious.read_text() == PRECIOUS, cmd
+        # a symbolic link to it is the same file
+        link = tmp_path / "link.txt"
+        link.unlink(missing_ok=True)
+        link.symlink_to(precious)
+        r = run([c if c != str(precious) else str(link) for c in cmd])
+        assert r.returncode == 2 and precious.read_text() == PRECIOUS, (cmd, r.stderr)
+
+
+def test_rvc_writes_over_its_own_files_new_and_empty_ones_and_devices(rvc, tmp_path):
+    for i, cmd_new in enumerate(_file_output_commands(rvc, tmp_path, str(tmp_path / "new.out"))):
+        out = tmp_path / f"out{i}.txt"
+        cmd = [c.replace(str(tmp_path / "new.out"), str(out)) for c in cmd_new]
+        first = run(cmd)
+        assert first.returncode in (0, 1), (cmd, first.stderr)
+        assert out.exists() and os.getxattr(out, "user.rvc.output") == b"1", cmd
+        again = run(cmd)  # the same command again writes over its own output
+        assert again.returncode == first.returncode, (cmd, again.stderr)
+        empty = tmp_path / f"empty{i}.txt"
+        empty.write_text("")  # mktemp's file: nothing to lose
+        r = run([c.replace(str(out), str(empty)) for c in cmd])
+        assert r.returncode == first.returncode, (cmd, r.stderr)
+        r = run([c.replace(str(out), "/dev/null") for c in cmd])
+        assert r.returncode == first.returncode, (cmd, r.stderr)
 
 
 # ---- rvc sync --set-type-dir writes only its own definitions ----
