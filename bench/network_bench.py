@@ -18,7 +18,12 @@ Baselines, measured in the same run, interleaved with the files (--baseline-reps
   the mean line length of the files; samples/s = what the subscriber counted / the publish seconds;
 - Zenoh: `rvc perf pub` -> `rvc perf sub` at size S: a plain Zenoh publisher/subscriber pair (the zenoh
   crate through rvc's C ABI: put with congestion control Block, callback subscriber that only counts);
-- CPU per sample (user + sys of each process, /usr/bin/time) of every publisher and subscriber.
+- CPU per sample (user + sys of each process, /usr/bin/time) of every publisher and subscriber, and
+  the ratio it implies where the CPU is the limit (2 cores, both processes busy): baseline (pub + sub)
+  CPU per sample / rvc (replay + monitor) CPU per sample; less noisy than samples/s on a loaded machine;
+- the cause, measured: dds-1pkt (one UDP packet per sample) on the first --cause-files files;
+- "baseline-bound network / local": the file's samples at the baseline's rate / `rvc check`'s time,
+  the best a monitor that cost nothing could do with one sample per event.
 Latency: publish -> verdict received back (`rvc monitor --all`, `rvc replay --latency-from`), a round
 trip, beside the transport's own ping round trip (ddsperf ping/pong; rvc perf ping/pong for Zenoh) at
 the same rates.
@@ -254,10 +259,15 @@ def main():
     ap.add_argument("--skip-baselines", action="store_true")
     ap.add_argument("--baseline-seconds", type=float, default=None, help="per baseline run (default 3, quick 2)")
     ap.add_argument("--baseline-reps", type=int, default=None, help="baseline runs per transport (default 3, quick 1)")
+    ap.add_argument("--cause-files", type=int, default=1,
+                    help="also run dds-1pkt (--no-dds-write-batch, the old default) on the first N files (0: none)")
     ap.add_argument("--batch", type=int, default=1, help="events per published sample (rvc replay --batch)")
     ap.add_argument("--build", default=os.path.join(ROOT, "build", "release"))
     ap.add_argument("--no-docs", action="store_true")
+    ap.add_argument("--from-json", metavar="FILE", help="only re-render the tables/plot of a saved run")
     args = ap.parse_args()
+    if args.from_json:
+        return rerender(args)
     q = args.quick
     args.steps = args.steps or (200_000 if q else 1_000_000)
     args.reps = args.reps or (1 if q else 3)
@@ -308,7 +318,9 @@ def main():
                               capture_output=True, text=True, check=True).stdout.strip()
         local_s = local_best(ctx, spec, path, args.reps)
         row = dict(property=name, local_ms=local_s * 1e3, load=loadavg())
-        for t in transports:
+        extra = ["dds-1pkt"] if n <= args.cause_files and "dds" in transports and "dds-1pkt" not in transports \
+            and args.batch == 1 else []
+        for t in transports + extra:
             stats, sent, cpu = run_pair(ctx, t, spec, path, extra_rep=["--batch", str(args.batch)])
             net_s = stats["done_at"] - sent["started_at"]
             nsamp = sent.get("samples", sent["sent"])
@@ -321,7 +333,7 @@ def main():
         rows.append(row)
         print(f"[{n:2d}/{len(files)}] {name:14s} local {local_s*1e3:6.0f} ms  " +
               "  ".join(f"{t} {row[f'{t}_ms']:6.0f} ms ({row[f'{t}_ratio']:.2f}x, {row[f'{t}_per_s']/1e3:.0f} kS/s, "
-                        f"lost {row[f'{t}_lost']})" for t in transports) + f"  load {row['load']:.1f}", flush=True)
+                        f"lost {row[f'{t}_lost']})" for t in transports + extra) + f"  load {row['load']:.1f}", flush=True)
 
     latency = []
     if not args.skip_latency:
@@ -348,16 +360,18 @@ def main():
                       f"({sent.get('verdicts_back', 0)}/{count} back)", flush=True)
 
     elapsed = time.time() - t_start
+    cmd = "python3 bench/network_bench.py" + (" " + " ".join(sys.argv[1:]) if sys.argv[1:] else "")
     out = os.path.join(ROOT, "bench", "results")
     os.makedirs(out, exist_ok=True)
     stem = os.path.join(out, f"network-batch{args.batch}")
     with open(stem + ".csv", "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
+        keys = list(dict.fromkeys(k for r in rows for k in r))
+        w = csv.DictWriter(f, fieldnames=keys, restval="")
         w.writeheader()
         w.writerows(rows)
     with open(stem + ".json", "w") as f:
-        json.dump(dict(rows=rows, baselines=base, latency=latency, size=size, elapsed_s=elapsed), f, indent=1)
-    cmd = "python3 bench/network_bench.py" + (" " + " ".join(sys.argv[1:]) if sys.argv[1:] else "")
+        json.dump(dict(rows=rows, baselines=base, latency=latency, size=size, elapsed_s=elapsed, transports=transports,
+                       args=vars(args), command=cmd), f, indent=1)
     md = render(rows, base, latency, transports, args, size, elapsed, cmd)
     with open(stem + ".md", "w") as f:
         f.write(md)
@@ -367,6 +381,26 @@ def main():
         tag = "network" if args.batch == 1 else f"network-batch{args.batch}"
         write_marked(os.path.join(ROOT, "docs", "performance.md"), tag, md)
     shutil.rmtree(tmp, ignore_errors=True)
+    print(md)
+
+
+def rerender(args):
+    with open(args.from_json) as f:
+        d = json.load(f)
+    saved = argparse.Namespace(**dict(vars(args), **d.get("args", {})))
+    saved.no_docs = args.no_docs
+    for k, v in (("steps", 1_000_000), ("reps", 3), ("baseline_seconds", 3), ("baseline_reps", 3)):
+        if getattr(saved, k, None) is None:
+            setattr(saved, k, v)
+    transports = d.get("transports") or [k[:-3] for k in d["rows"][0] if k.endswith("_ms") and k != "local_ms"
+                                         and k != "dds-1pkt_ms"]
+    md = render(d["rows"], d["baselines"], d["latency"], transports, saved, d["size"], d["elapsed_s"],
+                d.get("command", "python3 bench/network_bench.py"))
+    if saved.batch == 1:
+        plot(d["rows"], d["baselines"], transports, os.path.join(ROOT, "docs", "network.png"))
+    if not saved.no_docs:
+        write_marked(os.path.join(ROOT, "docs", "performance.md"),
+                     "network" if saved.batch == 1 else f"network-batch{saved.batch}", md)
     print(md)
 
 
@@ -400,9 +434,9 @@ def render(rows, base, latency, transports, args, size, elapsed, cmd):
         out.append(f"Against the transport's own publisher → subscriber at the same sample size ({size} B, the mean "
                    f"line; {args.baseline_seconds:g} s runs, median of {args.baseline_reps}, interleaved with the files):\n")
         out.append("| transport | baseline | baseline kS/s | rvc replay → monitor kS/s (median of files) | rvc / baseline "
-                   "| baseline pub / sub CPU µs per sample | rvc replay / monitor CPU µs per sample | baseline-bound "
-                   "network / local | load |")
-        out.append("|---|---|---:|---:|---:|---:|---:|---:|---:|")
+                   "| baseline pub / sub CPU µs per sample | rvc replay / monitor CPU µs per sample | CPU-bound rvc / "
+                   "baseline | baseline-bound network / local | load |")
+        out.append("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|")
         for k, label in (("dds", "ddsperf pub → ddsperf sub"), ("zenoh", "rvc perf pub → sub (zenoh crate)")):
             if not base[k]:
                 continue
@@ -413,10 +447,18 @@ def render(rows, base, latency, transports, args, size, elapsed, cmd):
             mine = med([r[f"{t}_per_s"] for r in rows])
             # the best ratio a monitor could reach if it cost nothing: the baseline's time for the file / local
             floor = med([args.steps / b / (r["local_ms"] / 1e3) for r in rows])
-            out.append(f"| {t} | {label} | {b / 1e3:.0f} | {mine / 1e3:.0f} | **{mine / b:.2f}** | "
-                       f"{med([x['pub_us'] for x in base[k]]):.2f} / {med([x['sub_us'] for x in base[k]]):.2f} | "
-                       f"{med([r[f'{t}_rep_us'] for r in rows]):.2f} / {med([r[f'{t}_mon_us'] for r in rows]):.2f} | "
-                       f"{floor:.2f} | {med([x['load'] for x in base[k]]):.1f} |")
+            bp, bs = med([x['pub_us'] for x in base[k]]), med([x['sub_us'] for x in base[k]])
+            variants = [(t, label)]
+            if k == "dds" and any("dds-1pkt_per_s" in r for r in rows):
+                variants.append(("dds-1pkt", label))
+            for tv, lab in variants:
+                sel = [r for r in rows if f"{tv}_per_s" in r]
+                mine = med([r[f"{tv}_per_s"] for r in sel])
+                rp, rm = med([r[f"{tv}_rep_us"] for r in sel]), med([r[f"{tv}_mon_us"] for r in sel])
+                name = tv if tv != "dds-1pkt" else f"dds-1pkt ({len(sel)} file{'s' if len(sel) != 1 else ''})"
+                out.append(f"| {name} | {lab} | {b / 1e3:.0f} | {mine / 1e3:.0f} | **{mine / b:.2f}** | "
+                           f"{bp:.2f} / {bs:.2f} | {rp:.2f} / {rm:.2f} | {(bp + bs) / (rp + rm):.2f} | "
+                           f"{floor:.2f} | {med([x['load'] for x in base[k]]):.1f} |")
     if latency:
         out.append("")
         out.append("Latency, publish → verdict received back (`rvc monitor --all`; a round trip) beside the "
@@ -432,7 +474,40 @@ def render(rows, base, latency, transports, args, size, elapsed, cmd):
                        f"{rv.get('p99', 0):.0f} | {pg.get('p99', float('nan')):.0f} | "
                        f"{rv.get('p99', 0) - pg.get('p99', float('nan')):+.0f} | {rv.get('max', 0):.0f} | "
                        f"{l['load']:.1f} |")
+    out += targets(rows, base, latency, transports, args)
     return "\n".join(out) + "\n"
+
+
+def targets(rows, base, latency, transports, args):
+    """Issue 27's targets against this run's figures: met, or not met with the measured bound."""
+    out = ["", "Targets (issue 27), from the figures above:\n", "| target | measured | met |", "|---|---|---|"]
+    yes = lambda ok: "**yes**" if ok else "no"  # noqa: E731
+    for k, t, want_rate, want_local in (("dds", "dds", 0.8, 2.0), ("zenoh", "zenoh-p2p", 0.8, 1.5)):
+        if t not in transports:
+            continue
+        ratios = [r[f"{t}_ratio"] for r in rows]
+        if base.get(k):
+            b = med([x["per_s"] for x in base[k]])
+            mine = med([r[f"{t}_per_s"] for r in rows])
+            cpu = (med([x["pub_us"] for x in base[k]]) + med([x["sub_us"] for x in base[k]])) / \
+                (med([r[f"{t}_rep_us"] for r in rows]) + med([r[f"{t}_mon_us"] for r in rows]))
+            out.append(f"| {t}: replay → monitor ≥ {want_rate}× the transport's own pub → sub, 0 lost | "
+                       f"{mine / b:.2f}× samples/s ({cpu:.2f}× by CPU per sample); lost "
+                       f"{sum(r[f'{t}_lost'] for r in rows)} | {yes(mine / b >= want_rate and not sum(r[f'{t}_lost'] for r in rows))} |")
+            floor = med([args.steps / b / (r["local_ms"] / 1e3) for r in rows])
+            bound = f"; the transport's own pub → sub alone needs {floor:.1f}× local for the same samples"
+        else:
+            bound = ""
+        out.append(f"| {t}: network / local ≤ {want_local}× ({args.batch} event(s) per sample) | median "
+                   f"{med(ratios):.2f}×{bound} | {yes(med(ratios) <= want_local)} |")
+    for l in latency:
+        rv, pg = l["rv"], l["ping"]
+        if not pg:
+            continue
+        d50, d99 = rv.get("p50", 0) - pg["p50"], rv.get("p99", 0) - pg["p99"]
+        out.append(f"| {l['transport']} at {l['rate']}/s: p50 ≤ ping p50 + 20 µs, p99 ≤ ping p99 + 50 µs | "
+                   f"p50 {d50:+.0f} µs, p99 {d99:+.0f} µs over the ping | {yes(d50 <= 20 and d99 <= 50)} |")
+    return out
 
 
 def plot(rows, base, transports, path):
