@@ -1,34 +1,56 @@
 #!/usr/bin/env python3
-"""RV over the network vs local: Timescales files through rvc replay ->
-transport -> rvc monitor, side by side with rvc check on the same file.
+"""RV over the network vs local, and vs the transport's own tools, in one run.
 
-  python3 bench/network_bench.py [--transports zenoh-p2p,zenoh-router,dds,dds-wb] [--steps 1000000]
+  python3 bench/network_bench.py            # 30 Timescales files, DDS + Zenoh p2p, baselines, latency: ~5 min
+  python3 bench/network_bench.py --quick    # 5 files of 200k events, shorter baselines: ~1 min
+  python3 bench/network_bench.py --batch 64 --skip-latency --skip-baselines   # 64 events per sample
 
-(dds-wb: DDS with rvc replay --dds-write-batch, several samples per UDP packet.)
+Per Timescales file and transport: `rvc replay FILE --to URI --rate max` -> `rvc monitor --input URI
+--exit-on-eos` (two processes on one host), time from replay's first publish (`started_at`) to the
+monitor's last verdict (`done_at`), beside `rvc check` on the same file (best of --reps), and the loss
+counters (gaps + duplicates + sent - received + sent - checked). Transports: dds (CycloneDDS on lo,
+reliable keep-all, rvc's defaults: replay packs samples into packets), dds-1pkt (the same with
+`--no-dds-write-batch`: one UDP packet per sample, the old default), zenoh-p2p (two peers over
+tcp/127.0.0.1), zenoh-router (both clients of an `rvc router`).
 
-For each file and transport: total time from the first publish (replay's
-started_at) to the last verdict out (monitor's done_at), and the loss
-counters; beside it `rvc check` on the same file, best of --reps. Then a
-ping-pong latency run per transport: publish -> verdict received back
-(monitor --all), p50/p90/p99 at 10 Hz, 1 kHz, 10 kHz and max.
+Baselines, measured in the same run, interleaved with the files (--baseline-reps times, median):
+- DDS: `ddsperf pub size S` -> `ddsperf sub` (reliable keep-all, what ddsperf does: write batching), S =
+  the mean line length of the files; samples/s = what the subscriber counted / the publish seconds;
+- Zenoh: `rvc perf pub` -> `rvc perf sub` at size S: a plain Zenoh publisher/subscriber pair (the zenoh
+  crate through rvc's C ABI: put with congestion control Block, callback subscriber that only counts);
+- CPU per sample (user + sys of each process, /usr/bin/time) of every publisher and subscriber, and
+  the ratio it implies where the CPU is the limit (2 cores, both processes busy): baseline (pub + sub)
+  CPU per sample / rvc (replay + monitor) CPU per sample; less noisy than samples/s on a loaded machine;
+- the cause, measured: dds-1pkt (one UDP packet per sample) on the first --cause-files files;
+- "baseline-bound network / local": the file's samples at the baseline's rate / `rvc check`'s time,
+  the best a monitor that cost nothing could do with one sample per event.
+Latency: publish -> verdict received back (`rvc monitor --all`, `rvc replay --latency-from`), a round
+trip, beside the transport's own ping round trip (ddsperf ping/pong; rvc perf ping/pong for Zenoh) at
+the same rates.
 
-Writes bench/results/network.{csv,md} and the tables into
-docs/performance.md between the network markers. A benchmark, not a test.
-All traffic on loopback: DDS pinned to lo, Zenoh on tcp/127.0.0.1 with
-multicast scouting off.
+Writes bench/results/network-batch{B}.{csv,md,json}, docs/network.png (--batch 1) and the tables into
+docs/performance.md between the network markers. A benchmark, not a test: it prints ratios measured side
+by side and asserts nothing. All traffic on loopback: DDS pinned to lo (rvc's generated config; ddsperf
+gets the XML of `rvc dds-config`), Zenoh on tcp/127.0.0.1 with multicast scouting off.
 """
 import argparse
 import csv
 import json
 import os
+import re
+import shutil
 import socket
+import statistics
 import subprocess
 import sys
+import tempfile
 import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "bench"))
-from timescales_bench import FAMILIES, BOUNDS, machine, best_of, write_marked  # noqa: E402
+from timescales_bench import FAMILIES, machine, write_marked  # noqa: E402
+
+TIME = "/usr/bin/time"
 
 
 def free_port():
@@ -39,18 +61,52 @@ def free_port():
     return p
 
 
+def loadavg():
+    return os.getloadavg()[0]
+
+
+def timed_cmd(cmd, tfile):
+    """cmd under /usr/bin/time writing 'elapsed user sys' to tfile (the command's own output untouched)."""
+    return [TIME, "-o", tfile, "-f", "%e %U %S"] + cmd
+
+
+def read_time(tfile):
+    with open(tfile) as f:
+        e, u, s = f.read().strip().splitlines()[-1].split()
+    return float(e), float(u) + float(s)
+
+
+class Ctx:
+    def __init__(self, args, tmp):
+        self.args, self.tmp = args, tmp
+        self.rvc = os.path.join(args.build, "rvc")
+        self.domain = 60
+        self.cfg = os.path.join(tmp, "dds.xml")
+        subprocess.run([self.rvc, "dds-config", "-o", self.cfg], check=True)
+        self.env = dict(os.environ, CYCLONEDDS_URI=f"file://{self.cfg}")
+        self.ddsperf = shutil.which("ddsperf")
+        self.n = 0
+
+    def next_domain(self):
+        self.domain = 61 + (self.domain - 60) % 150
+        return self.domain
+
+    def tfile(self, tag):
+        self.n += 1
+        return os.path.join(self.tmp, f"{tag}-{self.n}.time")
+
+
 class Setup:
-    def __init__(self, rvc, name, domain):
-        self.rvc, self.name, self.router = rvc, name, None
-        if name in ("dds", "dds-wb"):
-            self.mon = self.rep = ["--domain", str(domain)]
-            if name == "dds-wb":  # replay packs samples into packets (CycloneDDS write batching)
-                self.rep = self.rep + ["--dds-write-batch"]
-            self.key = "dds:/rv/bench"
-            self.out = "dds:/rv/bench_verdicts"
+    def __init__(self, ctx, name):
+        self.ctx, self.name, self.router = ctx, name, None
+        rvc = ctx.rvc
+        if name.startswith("dds"):
+            self.mon = self.rep = ["--domain", str(ctx.next_domain())]
+            if name == "dds-1pkt":
+                self.rep = self.rep + ["--no-dds-write-batch"]
+            self.key, self.out = "dds:/rv/bench", "dds:/rv/bench_verdicts"
         else:
-            port = free_port()
-            ep = f"tcp/127.0.0.1:{port}"
+            ep = f"tcp/127.0.0.1:{free_port()}"
             self.key, self.out = "zenoh:rv/bench", "zenoh:rv/bench_verdicts"
             if name == "zenoh-router":
                 self.router = subprocess.Popen([rvc, "router", "--listen", ep, "--no-multicast-scouting"],
@@ -67,105 +123,298 @@ class Setup:
             self.router.wait()
 
 
-def run_pair(setup, spec, trace, extra_mon=(), extra_rep=(), output="file:/dev/null"):
-    rvc = setup.rvc
-    mon = subprocess.Popen([rvc, "monitor", "--spec", spec, "--input", setup.key, "--output", output,
-                            "--exit-on-eos", *extra_mon, *setup.mon], stdout=subprocess.DEVNULL,
-                           stderr=subprocess.PIPE, text=True)
-    rep = subprocess.run([rvc, "replay", trace, "--to", setup.key, "--no-progress", "--wait-timeout", "30",
-                          *extra_rep, *setup.rep], capture_output=True, text=True)
-    _, err = mon.communicate(timeout=900)
+def run_pair(ctx, t, spec, trace, extra_mon=(), extra_rep=(), output="file:/dev/null"):
+    """replay -> monitor over transport t; returns (monitor stats, replay summary, cpu dict)."""
+    setup = Setup(ctx, t)
+    tm, tr = ctx.tfile("mon"), ctx.tfile("rep")
+    try:
+        mon = subprocess.Popen(timed_cmd([ctx.rvc, "monitor", "--spec", spec, "--input", setup.key, "--output", output,
+                                          "--exit-on-eos", *extra_mon, *setup.mon], tm),
+                               stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+        rep = subprocess.run(timed_cmd([ctx.rvc, "replay", trace, "--to", setup.key, "--no-progress", "--wait-timeout",
+                                        "30", *extra_rep, *setup.rep], tr), capture_output=True, text=True)
+        _, err = mon.communicate(timeout=600)
+    finally:
+        setup.close()
     stats = json.loads([l for l in err.splitlines() if l.startswith("{")][-1])
-    sent = json.loads(rep.stdout.strip().splitlines()[-1])
-    return stats, sent
+    sent = json.loads([l for l in rep.stdout.splitlines() if l.startswith("{")][-1])
+    return stats, sent, {"monitor": read_time(tm)[1], "replay": read_time(tr)[1]}
 
+
+def lost_of(stats, sent):
+    return stats["gaps"] + stats["duplicates"] + (sent.get("samples", sent["sent"]) - stats["received"]) \
+        + (sent["sent"] - stats["checked"])
+
+
+def local_best(ctx, spec, path, reps):
+    best = None
+    for _ in range(reps):
+        t0 = time.perf_counter()
+        subprocess.run([ctx.rvc, "check", "--spec", spec, path], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        dt = time.perf_counter() - t0
+        best = dt if best is None else min(best, dt)
+    return best
+
+
+# ------------------------------------------------------------------ baselines
+
+def ddsperf_throughput(ctx, size, secs):
+    """ddsperf pub size S -> ddsperf sub: samples/s and CPU us per sample of each side."""
+    d = str(ctx.next_domain())
+    out = open(os.path.join(ctx.tmp, "ddsperf-sub.txt"), "w+")
+    ts, tp = ctx.tfile("dsub"), ctx.tfile("dpub")
+    sub = subprocess.Popen(timed_cmd([ctx.ddsperf, "-i", d, "-D", str(secs + 2), "sub"], ts), env=ctx.env,
+                           stdout=out, stderr=subprocess.STDOUT)
+    time.sleep(0.5)
+    subprocess.run(timed_cmd([ctx.ddsperf, "-i", d, "-D", str(secs), "pub", "size", str(size)], tp), env=ctx.env,
+                   stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, timeout=secs + 30)
+    sub.wait(timeout=60)
+    out.seek(0)
+    text = out.read()
+    out.close()
+    totals = [(int(m.group(1)), int(m.group(2))) for m in re.finditer(r"size \d+ total (\d+) lost (\d+)", text)]
+    total, lost = totals[-1] if totals else (0, 0)
+    return dict(per_s=total / secs, samples=total, lost=lost,
+                pub_us=read_time(tp)[1] / max(total, 1) * 1e6, sub_us=read_time(ts)[1] / max(total, 1) * 1e6)
+
+
+def zenoh_throughput(ctx, size, secs):
+    """rvc perf pub -> rvc perf sub over Zenoh p2p (a plain zenoh pub/sub pair)."""
+    ep = f"tcp/127.0.0.1:{free_port()}"
+    ts, tp = ctx.tfile("zsub"), ctx.tfile("zpub")
+    sub = subprocess.Popen(timed_cmd([ctx.rvc, "perf", "sub", "-t", "zenoh", "--listen", ep, "--no-multicast-scouting",
+                                      "--report-interval", "0"], ts), stdout=subprocess.PIPE,
+                           stderr=subprocess.DEVNULL, text=True)
+    time.sleep(0.3)
+    subprocess.run(timed_cmd([ctx.rvc, "perf", "pub", "-t", "zenoh", "--connect", ep, "--no-multicast-scouting",
+                              "--size", str(size), "--duration", str(secs), "--report-interval", "0"], tp),
+                   stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, timeout=secs + 60)
+    out, _ = sub.communicate(timeout=60)
+    r = json.loads(out.strip().splitlines()[-1])
+    n = r["received"]
+    return dict(per_s=r["avg_msgs_per_s"], samples=n, lost=r["lost"],
+                pub_us=read_time(tp)[1] / max(n, 1) * 1e6, sub_us=read_time(ts)[1] / max(n, 1) * 1e6)
+
+
+def ddsperf_ping(ctx, rate, size, secs):
+    """ddsperf ping/pong: round-trip percentiles (ddsperf prints RTT/2 per second; x2, cnt-weighted mean
+    of the per-second values, first second left out)."""
+    d = str(ctx.next_domain())
+    pong = subprocess.Popen([ctx.ddsperf, "-i", d, "-D", str(secs + 3), "pong"], env=ctx.env,
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    time.sleep(0.5)
+    out = subprocess.run([ctx.ddsperf, "-i", d, "-D", str(secs + 1), "ping", f"{rate}Hz", "size", str(size)],
+                         env=ctx.env, capture_output=True, text=True, timeout=secs + 30).stdout
+    pong.wait(timeout=30)
+    rows = []
+    for m in re.finditer(r"\] (\d+\.\d+)\s+\S+ size \d+ mean [\d.]+us min [\d.]+us 50% ([\d.]+)us 90% ([\d.]+)us "
+                         r"99% ([\d.]+)us max ([\d.]+)us cnt (\d+)", out):
+        if float(m.group(1)) > 1.5:
+            rows.append([float(m.group(i)) for i in range(2, 7)])
+    if not rows:
+        return {}
+    cnt = sum(r[4] for r in rows)
+    avg = lambda i: 2 * sum(r[i] * r[4] for r in rows) / cnt  # noqa: E731
+    return dict(p50=avg(0), p90=avg(1), p99=avg(2), max=2 * max(r[3] for r in rows), count=int(cnt))
+
+
+def zenoh_ping(ctx, rate, size, secs):
+    """rvc perf ping/pong over Zenoh p2p; rvc perf reports RTT/2: x2."""
+    ep = f"tcp/127.0.0.1:{free_port()}"
+    pong = subprocess.Popen([ctx.rvc, "perf", "pong", "-t", "zenoh", "--listen", ep, "--no-multicast-scouting",
+                             "--report-interval", "0"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    time.sleep(0.3)
+    out = subprocess.run([ctx.rvc, "perf", "ping", "-t", "zenoh", "--connect", ep, "--no-multicast-scouting",
+                          "--rate", str(rate), "--size", str(size), "--duration", str(secs), "--warmup", "0.5",
+                          "--report-interval", "0"], capture_output=True, text=True, timeout=secs + 60).stdout
+    pong.terminate()
+    pong.wait()
+    r = json.loads(out.strip().splitlines()[-1])
+    return dict(p50=2 * r["p50_us"], p90=2 * r["p90_us"], p99=2 * r["p99_us"], max=2 * r["max_us"], count=r["count"])
+
+
+def mean_line_bytes(path, limit=20000):
+    n = tot = 0
+    with open(path, "rb") as f:
+        for line in f:
+            n += 1
+            tot += len(line.rstrip(b"\n"))
+            if n >= limit:
+                break
+    return tot / max(n, 1)
+
+
+# ---------------------------------------------------------------------- main
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--transports", default="zenoh-p2p,zenoh-router,dds,dds-wb")
-    ap.add_argument("--steps", type=int, default=1_000_000)
-    ap.add_argument("--reps", type=int, default=3)
-    ap.add_argument("--families", default=",".join(FAMILIES))
+    ap.add_argument("--quick", action="store_true", help="5 files of 200k events, 1 rep, short baselines (~1 min)")
+    ap.add_argument("--transports", default="dds,zenoh-p2p",
+                    help="comma list of dds, dds-1pkt, zenoh-p2p, zenoh-router")
+    ap.add_argument("--steps", type=int, default=None, help="events per file (default 1M, --quick 200k)")
+    ap.add_argument("--reps", type=int, default=None, help="rvc check repetitions, best taken (default 3, quick 1)")
+    ap.add_argument("--families", default=None)
     ap.add_argument("--bounds", default="10,100,1000")
     ap.add_argument("--skip-latency", action="store_true")
+    ap.add_argument("--skip-baselines", action="store_true")
+    ap.add_argument("--baseline-seconds", type=float, default=None, help="per baseline run (default 3, quick 2)")
+    ap.add_argument("--baseline-reps", type=int, default=None, help="baseline runs per transport (default 3, quick 1)")
+    ap.add_argument("--cause-files", type=int, default=1,
+                    help="also run dds-1pkt (--no-dds-write-batch, the old default) on the first N files (0: none)")
     ap.add_argument("--batch", type=int, default=1, help="events per published sample (rvc replay --batch)")
     ap.add_argument("--build", default=os.path.join(ROOT, "build", "release"))
     ap.add_argument("--no-docs", action="store_true")
+    ap.add_argument("--from-json", metavar="FILE", help="only re-render the tables/plot of a saved run")
     args = ap.parse_args()
-    rvc = os.path.join(args.build, "rvc")
-    help_text = subprocess.run([rvc, "monitor", "--help"], capture_output=True, text=True).stdout
-    transports = [t for t in args.transports.split(",")
-                  if (t.startswith("dds") and "--domain" in help_text) or (t.startswith("zenoh") and "--connect" in help_text)]
-    data = os.path.join(ROOT, "bench", "results", "timescales")
+    if args.from_json:
+        return rerender(args)
+    q = args.quick
+    args.steps = args.steps or (200_000 if q else 1_000_000)
+    args.reps = args.reps or (1 if q else 3)
+    args.baseline_seconds = args.baseline_seconds or (2 if q else 3)
+    args.baseline_reps = args.baseline_reps or (1 if q else 3)
+    families = (args.families or ("AbsentAQ,AlwaysBR,RecurGLB,RespondBQR,AbsentBQR" if q else ",".join(FAMILIES)))
+    bounds = "100" if q and args.bounds == "10,100,1000" else args.bounds
+    t_start = time.time()
+    tmp = tempfile.mkdtemp(prefix="rvc-netbench-")
+    ctx = Ctx(args, tmp)
+    rvc = ctx.rvc
+    transports = args.transports.split(",")
+    if not ctx.ddsperf and not args.skip_baselines and any(t.startswith("dds") for t in transports):
+        sys.exit("ddsperf missing (Debian cyclonedds-tools): needed for the DDS baseline (or --skip-baselines)")
+    data = os.path.join(ROOT, "bench", "results", "timescales" if args.steps == 1_000_000 else f"timescales-{args.steps}")
     os.makedirs(data, exist_ok=True)
-    rows = []
-    domain = 60
-    files = [(f, int(b)) for f in args.families.split(",") for b in args.bounds.split(",")]
-    for n, (family, bound) in enumerate(files, 1):
-        name = f"{family}{bound}"
-        path = os.path.join(data, f"{name}.jsonl")
+    files = [(f, int(b)) for f in families.split(",") for b in bounds.split(",")]
+    paths = []
+    for family, bound in files:
+        path = os.path.join(data, f"{family}{bound}.jsonl")
         if not os.path.exists(path):
             subprocess.run([rvc, "timescales", family, "--ubound", str(bound), "--duration", str(args.steps),
                             "--seed", "1", "-o", path], check=True)
+        paths.append(path)
+    size = int(round(statistics.mean(mean_line_bytes(p) for p in paths)))
+
+    # Baseline runs spread over the file loop (same load as the files they are compared with).
+    base = {"dds": [], "zenoh": []}
+    want_base = [] if args.skip_baselines or args.batch != 1 else \
+        [k for k in ("dds", "zenoh") if any(t.startswith(k) for t in transports)]
+    slots = {int(i * len(files) / max(args.baseline_reps, 1)) for i in range(args.baseline_reps)}
+
+    def baseline_rep():
+        for k in want_base:
+            r = ddsperf_throughput(ctx, size, args.baseline_seconds) if k == "dds" \
+                else zenoh_throughput(ctx, size, args.baseline_seconds)
+            r["load"] = loadavg()
+            base[k].append(r)
+            print(f"baseline {k:5s} size {size} B: {r['per_s'] / 1e3:7.0f} kS/s  pub {r['pub_us']:.2f} us/S  "
+                  f"sub {r['sub_us']:.2f} us/S  lost {r['lost']}  load {r['load']:.1f}", flush=True)
+
+    rows = []
+    for n, ((family, bound), path) in enumerate(zip(files, paths), 1):
+        if n - 1 in slots:
+            baseline_rep()
+        name = f"{family}{bound}"
         spec = subprocess.run([rvc, "timescales", family, "--ubound", str(bound), "--formula"],
                               capture_output=True, text=True, check=True).stdout.strip()
-        local_s, _, _ = best_of([rvc, "check", "--spec", spec, path], args.reps)
-        row = dict(property=name, local_ms=local_s * 1e3)
-        for t in transports:
-            domain += 1
-            setup = Setup(rvc, t, domain)
-            try:
-                stats, sent = run_pair(setup, spec, path, extra_rep=["--batch", str(args.batch)])
-            finally:
-                setup.close()
+        local_s = local_best(ctx, spec, path, args.reps)
+        row = dict(property=name, local_ms=local_s * 1e3, load=loadavg())
+        extra = ["dds-1pkt"] if n <= args.cause_files and "dds" in transports and "dds-1pkt" not in transports \
+            and args.batch == 1 else []
+        for t in transports + extra:
+            stats, sent, cpu = run_pair(ctx, t, spec, path, extra_rep=["--batch", str(args.batch)])
             net_s = stats["done_at"] - sent["started_at"]
+            nsamp = sent.get("samples", sent["sent"])
             row[f"{t}_ms"] = net_s * 1e3
             row[f"{t}_ratio"] = net_s / local_s
-            row[f"{t}_lost"] = stats["gaps"] + stats["duplicates"] + (sent.get("samples", sent["sent"]) - stats["received"]) \
-                + (sent["sent"] - stats["checked"])
+            row[f"{t}_per_s"] = nsamp / net_s
+            row[f"{t}_rep_us"] = cpu["replay"] / nsamp * 1e6
+            row[f"{t}_mon_us"] = cpu["monitor"] / nsamp * 1e6
+            row[f"{t}_lost"] = lost_of(stats, sent)
         rows.append(row)
-        print(f"[{n:2d}/{len(files)}] {name:14s} local {local_s*1e3:7.1f} ms  " +
-              "  ".join(f"{t} {row[f'{t}_ms']:8.1f} ms ({row[f'{t}_ratio']:.2f}x, lost {row[f'{t}_lost']})"
-                        for t in transports), flush=True)
+        print(f"[{n:2d}/{len(files)}] {name:14s} local {local_s*1e3:6.0f} ms  " +
+              "  ".join(f"{t} {row[f'{t}_ms']:6.0f} ms ({row[f'{t}_ratio']:.2f}x, {row[f'{t}_per_s']/1e3:.0f} kS/s, "
+                        f"lost {row[f'{t}_lost']})" for t in transports + extra) + f"  load {row['load']:.1f}", flush=True)
 
     latency = []
     if not args.skip_latency:
-        for t in transports:
-            for rate, count in (("10", 100), ("1000", 3000), ("10000", 30000), ("max", 100000)):
-                domain += 1
-                setup = Setup(rvc, t, domain)
+        lat_secs = 1 if q else 3
+        trace_rates = [(1000, 1000 * lat_secs), (10000, 10000 * lat_secs)]
+        for t in [t for t in transports if t in ("dds", "zenoh-p2p")]:
+            for rate, count in trace_rates:
                 trace = os.path.join(data, f"latency_{count}.jsonl")
                 if not os.path.exists(trace):
                     subprocess.run([rvc, "timescales", "RecurGLB", "--ubound", "10", "--duration", str(count),
                                     "--seed", "3", "-o", trace], check=True)
-                try:
-                    stats, sent = run_pair(setup, "once[:10]{p}", trace, extra_mon=["--all"],
-                                           extra_rep=["--rate", rate, "--latency-from", setup.out],
-                                           output=setup.out)
-                finally:
-                    setup.close()
+                setup_out = "dds:/rv/bench_verdicts" if t.startswith("dds") else "zenoh:rv/bench_verdicts"
+                stats, sent, _ = run_pair(ctx, t, "once[:10]{p}", trace, extra_mon=["--all"],
+                                          extra_rep=["--rate", str(rate), "--latency-from", setup_out],
+                                          output=setup_out)
                 lat = sent.get("latency_us", {})
-                latency.append(dict(transport=t, rate=rate, messages=count, back=sent.get("verdicts_back", 0), **lat))
-                print(f"latency {t:13s} rate {rate:>5s}: p50 {lat.get('p50', 0):8.1f} us  p90 {lat.get('p90', 0):8.1f}"
-                      f"  p99 {lat.get('p99', 0):9.1f}  ({sent.get('verdicts_back', 0)}/{count} back)", flush=True)
+                lsize = int(round(mean_line_bytes(trace)))
+                ping = ddsperf_ping(ctx, rate, lsize, lat_secs + 1) if t.startswith("dds") \
+                    else zenoh_ping(ctx, rate, lsize, lat_secs + 1)
+                latency.append(dict(transport=t, rate=rate, messages=count, back=sent.get("verdicts_back", 0),
+                                    rv=lat, ping=ping, load=loadavg()))
+                print(f"latency {t:10s} {rate:>6d}/s: rv p50 {lat.get('p50', 0):7.1f} p99 {lat.get('p99', 0):8.1f} us"
+                      f" | ping RTT p50 {ping.get('p50', 0):7.1f} p99 {ping.get('p99', 0):8.1f} us "
+                      f"({sent.get('verdicts_back', 0)}/{count} back)", flush=True)
 
+    elapsed = time.time() - t_start
+    cmd = "python3 bench/network_bench.py" + (" " + " ".join(sys.argv[1:]) if sys.argv[1:] else "")
     out = os.path.join(ROOT, "bench", "results")
-    with open(os.path.join(out, f"network-batch{args.batch}.csv"), "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
+    os.makedirs(out, exist_ok=True)
+    stem = os.path.join(out, f"network-batch{args.batch}")
+    with open(stem + ".csv", "w", newline="") as f:
+        keys = list(dict.fromkeys(k for r in rows for k in r))
+        w = csv.DictWriter(f, fieldnames=keys, restval="")
         w.writeheader()
         w.writerows(rows)
-    md = render(rows, latency, transports, args)
-    with open(os.path.join(out, f"network-batch{args.batch}.md"), "w") as f:
+    with open(stem + ".json", "w") as f:
+        json.dump(dict(rows=rows, baselines=base, latency=latency, size=size, elapsed_s=elapsed, transports=transports,
+                       args=vars(args), command=cmd), f, indent=1)
+    md = render(rows, base, latency, transports, args, size, elapsed, cmd)
+    with open(stem + ".md", "w") as f:
         f.write(md)
+    if args.batch == 1:
+        plot(rows, base, transports, os.path.join(ROOT, "docs", "network.png"))
     if not args.no_docs:
         tag = "network" if args.batch == 1 else f"network-batch{args.batch}"
         write_marked(os.path.join(ROOT, "docs", "performance.md"), tag, md)
+    shutil.rmtree(tmp, ignore_errors=True)
     print(md)
 
 
-def render(rows, latency, transports, args):
-    out = [f"Machine: {machine()}. {args.steps:,} events per file, {args.batch} event(s) per published sample; "
-           f"network time = first publish to last verdict; local = `rvc check`, best of {args.reps}.\n"]
+def rerender(args):
+    with open(args.from_json) as f:
+        d = json.load(f)
+    saved = argparse.Namespace(**dict(vars(args), **d.get("args", {})))
+    saved.no_docs = args.no_docs
+    for k, v in (("steps", 1_000_000), ("reps", 3), ("baseline_seconds", 3), ("baseline_reps", 3)):
+        if getattr(saved, k, None) is None:
+            setattr(saved, k, v)
+    transports = d.get("transports") or [k[:-3] for k in d["rows"][0] if k.endswith("_ms") and k != "local_ms"
+                                         and k != "dds-1pkt_ms"]
+    md = render(d["rows"], d["baselines"], d["latency"], transports, saved, d["size"], d["elapsed_s"],
+                d.get("command", "python3 bench/network_bench.py"))
+    if saved.batch == 1:
+        plot(d["rows"], d["baselines"], transports, os.path.join(ROOT, "docs", "network.png"))
+    if not saved.no_docs:
+        write_marked(os.path.join(ROOT, "docs", "performance.md"),
+                     "network" if saved.batch == 1 else f"network-batch{saved.batch}", md)
+    print(md)
+
+
+def med(xs):
+    xs = [x for x in xs if x == x]
+    return statistics.median(xs) if xs else float("nan")
+
+
+def render(rows, base, latency, transports, args, size, elapsed, cmd):
+    loads = [r["load"] for r in rows]
+    out = [f"Machine: {machine()}; load average (1 min) {min(loads):.1f}–{max(loads):.1f} during the run. "
+           f"{args.steps:,} events per file, {args.batch} event(s) per published sample; network time = first "
+           f"publish to last verdict; local = `rvc check`, best of {args.reps}. Run time {elapsed / 60:.1f} min. "
+           f"Command: `{cmd}`.\n"]
     head = "| property | local ms | " + " | ".join(f"{t} ms | {t} / local | {t} lost" for t in transports) + " |"
     out.append(head)
     out.append("|---|---:|" + "---:|---:|---:|" * len(transports))
@@ -176,17 +425,125 @@ def render(rows, latency, transports, args):
     for t in transports:
         ratios = [r[f"{t}_ratio"] for r in rows]
         lost = sum(r[f"{t}_lost"] for r in rows)
-        out.append(f"- {t}: network / local ratio median **{sorted(ratios)[len(ratios)//2]:.2f}**, "
-                   f"min {min(ratios):.2f}, max {max(ratios):.2f}; lost {lost}")
+        out.append(f"- {t}: network / local median **{med(ratios):.2f}**, min {min(ratios):.2f}, "
+                   f"max {max(ratios):.2f}; median {med([r[f'{t}_per_s'] for r in rows]) / 1e3:.0f} k samples/s; "
+                   f"CPU per sample: replay {med([r[f'{t}_rep_us'] for r in rows]):.2f} µs, monitor "
+                   f"{med([r[f'{t}_mon_us'] for r in rows]):.2f} µs; lost {lost}")
+    if any(base.values()):
+        out.append("")
+        out.append(f"Against the transport's own publisher → subscriber at the same sample size ({size} B, the mean "
+                   f"line; {args.baseline_seconds:g} s runs, median of {args.baseline_reps}, interleaved with the files):\n")
+        out.append("| transport | baseline | baseline kS/s | rvc replay → monitor kS/s (median of files) | rvc / baseline "
+                   "| baseline pub / sub CPU µs per sample | rvc replay / monitor CPU µs per sample | CPU-bound rvc / "
+                   "baseline | baseline-bound network / local | load |")
+        out.append("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|")
+        for k, label in (("dds", "ddsperf pub → ddsperf sub"), ("zenoh", "rvc perf pub → sub (zenoh crate)")):
+            if not base[k]:
+                continue
+            t = "dds" if k == "dds" else "zenoh-p2p"
+            if t not in transports:
+                continue
+            b = med([x["per_s"] for x in base[k]])
+            mine = med([r[f"{t}_per_s"] for r in rows])
+            # the best ratio a monitor could reach if it cost nothing: the baseline's time for the file / local
+            floor = med([args.steps / b / (r["local_ms"] / 1e3) for r in rows])
+            bp, bs = med([x['pub_us'] for x in base[k]]), med([x['sub_us'] for x in base[k]])
+            variants = [(t, label)]
+            if k == "dds" and any("dds-1pkt_per_s" in r for r in rows):
+                variants.append(("dds-1pkt", label))
+            for tv, lab in variants:
+                sel = [r for r in rows if f"{tv}_per_s" in r]
+                mine = med([r[f"{tv}_per_s"] for r in sel])
+                rp, rm = med([r[f"{tv}_rep_us"] for r in sel]), med([r[f"{tv}_mon_us"] for r in sel])
+                name = tv if tv != "dds-1pkt" else f"dds-1pkt ({len(sel)} file{'s' if len(sel) != 1 else ''})"
+                out.append(f"| {name} | {lab} | {b / 1e3:.0f} | {mine / 1e3:.0f} | **{mine / b:.2f}** | "
+                           f"{bp:.2f} / {bs:.2f} | {rp:.2f} / {rm:.2f} | {(bp + bs) / (rp + rm):.2f} | "
+                           f"{floor:.2f} | {med([x['load'] for x in base[k]]):.1f} |")
     if latency:
         out.append("")
-        out.append("Publish -> verdict received back (monitor --all), microseconds:\n")
-        out.append("| transport | rate (msg/s) | messages | verdicts back | p50 | p90 | p99 | max |")
-        out.append("|---|---:|---:|---:|---:|---:|---:|---:|")
+        out.append("Latency, publish → verdict received back (`rvc monitor --all`; a round trip) beside the "
+                   "transport's own ping round trip at the same rate and size (DDS: ddsperf ping/pong, which prints "
+                   "RTT/2, doubled; Zenoh: rvc perf ping/pong, doubled), microseconds:\n")
+        out.append("| transport | rate (msg/s) | verdicts back | rv p50 | ping p50 | rv − ping p50 | rv p99 | ping p99 | "
+                   "rv − ping p99 | rv max | load |")
+        out.append("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
         for l in latency:
-            out.append(f"| {l['transport']} | {l['rate']} | {l['messages']} | {l['back']} | {l.get('p50', 0):.0f} | "
-                       f"{l.get('p90', 0):.0f} | {l.get('p99', 0):.0f} | {l.get('max', 0):.0f} |")
+            rv, pg = l["rv"], l["ping"]
+            out.append(f"| {l['transport']} | {l['rate']} | {l['back']}/{l['messages']} | {rv.get('p50', 0):.0f} | "
+                       f"{pg.get('p50', float('nan')):.0f} | {rv.get('p50', 0) - pg.get('p50', float('nan')):+.0f} | "
+                       f"{rv.get('p99', 0):.0f} | {pg.get('p99', float('nan')):.0f} | "
+                       f"{rv.get('p99', 0) - pg.get('p99', float('nan')):+.0f} | {rv.get('max', 0):.0f} | "
+                       f"{l['load']:.1f} |")
+    out += targets(rows, base, latency, transports, args)
     return "\n".join(out) + "\n"
+
+
+def targets(rows, base, latency, transports, args):
+    """Issue 27's targets against this run's figures: met, or not met with the measured bound."""
+    out = ["", "Targets (issue 27), from the figures above:\n", "| target | measured | met |", "|---|---|---|"]
+    yes = lambda ok: "**yes**" if ok else "no"  # noqa: E731
+    for k, t, want_rate, want_local in (("dds", "dds", 0.8, 2.0), ("zenoh", "zenoh-p2p", 0.8, 1.5)):
+        if t not in transports:
+            continue
+        ratios = [r[f"{t}_ratio"] for r in rows]
+        if base.get(k):
+            b = med([x["per_s"] for x in base[k]])
+            mine = med([r[f"{t}_per_s"] for r in rows])
+            cpu = (med([x["pub_us"] for x in base[k]]) + med([x["sub_us"] for x in base[k]])) / \
+                (med([r[f"{t}_rep_us"] for r in rows]) + med([r[f"{t}_mon_us"] for r in rows]))
+            out.append(f"| {t}: replay → monitor ≥ {want_rate}× the transport's own pub → sub, 0 lost | "
+                       f"{mine / b:.2f}× samples/s ({cpu:.2f}× by CPU per sample); lost "
+                       f"{sum(r[f'{t}_lost'] for r in rows)} | {yes(mine / b >= want_rate and not sum(r[f'{t}_lost'] for r in rows))} |")
+            floor = med([args.steps / b / (r["local_ms"] / 1e3) for r in rows])
+            bound = f"; the transport's own pub → sub alone needs {floor:.1f}× local for the same samples"
+        else:
+            bound = ""
+        out.append(f"| {t}: network / local ≤ {want_local}× ({args.batch} event(s) per sample) | median "
+                   f"{med(ratios):.2f}×{bound} | {yes(med(ratios) <= want_local)} |")
+    for l in latency:
+        rv, pg = l["rv"], l["ping"]
+        if not pg:
+            continue
+        d50, d99 = rv.get("p50", 0) - pg["p50"], rv.get("p99", 0) - pg["p99"]
+        out.append(f"| {l['transport']} at {l['rate']}/s: p50 ≤ ping p50 + 20 µs, p99 ≤ ping p99 + 50 µs | "
+                   f"p50 {d50:+.0f} µs, p99 {d99:+.0f} µs over the ping | {yes(d50 <= 20 and d99 <= 50)} |")
+    return out
+
+
+def plot(rows, base, transports, path):
+    try:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        print("matplotlib missing: no plot", file=sys.stderr)
+        return
+    fig, (a1, a2) = plt.subplots(1, 2, figsize=(15, 4.5), gridspec_kw=dict(width_ratios=[3, 1]))
+    names = [r["property"] for r in rows]
+    x = range(len(rows))
+    w = 0.8 / len(transports)
+    for i, t in enumerate(transports):
+        a1.bar([j - 0.4 + (i + 0.5) * w for j in x], [r[f"{t}_ratio"] for r in rows], w, label=t)
+    a1.axhline(2, color="k", lw=0.8, ls="--")
+    a1.set_xticks(list(x))
+    a1.set_xticklabels(names, rotation=70, fontsize=7)
+    a1.set_ylabel("network / local (rvc check)")
+    a1.set_title("One sample per event: replay → monitor vs rvc check")
+    a1.legend()
+    labels, vals, colors = [], [], []
+    for k, t in (("dds", "dds"), ("zenoh", "zenoh-p2p")):
+        if base.get(k) and t in transports:
+            labels += [f"{k}\nbaseline", f"{k}\nrvc"]
+            vals += [med([b["per_s"] for b in base[k]]) / 1e3, med([r[f"{t}_per_s"] for r in rows]) / 1e3]
+            colors += ["0.6", "C0" if k == "dds" else "C1"]
+    if vals:
+        a2.bar(range(len(vals)), vals, color=colors)
+        a2.set_xticks(range(len(vals)))
+        a2.set_xticklabels(labels, fontsize=8)
+        a2.set_ylabel("k samples/s")
+        a2.set_title("vs the transport's own pub → sub")
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
 
 
 if __name__ == "__main__":

@@ -261,10 +261,11 @@ def markdown(rows, settings, systems, meta, images, notes):
     w("Systems:\n")
     w("* **rvc perf, Zenoh**: `rvc perf pub/sub --transport zenoh`, reliable, congestion control Block, "
       "peer to peer over TCP.")
-    w("* **rvc perf, DDS**: `rvc perf pub/sub --transport dds` (rvc's CycloneDDS transport as `rvc replay`/"
-      "`rvc monitor` use it: reliable, keep-all, one packet per sample).")
+    w("* **rvc perf, DDS**: `rvc perf pub/sub --transport dds --no-dds-write-batch` (rvc's CycloneDDS transport: "
+      "reliable, keep-all, one packet per sample, what `rvc replay` did by default until 2026-11-27).")
     w("* **rvc perf, DDS + write batching**: the same with `--write-batch` (CycloneDDS `Internal/WriteBatch`, "
-      "several samples per packet, which is what ddsperf does); throughput only.")
+      "several samples per packet, which is what ddsperf does and what `rvc replay` and `rvc perf pub` now do by "
+      "default); throughput only.")
     w("* **rvc DDS->Zenoh bridge**: `rvc perf pub --transport dds` -> `rvc bridge dds:… zenoh:…` -> "
       "`rvc perf sub --transport zenoh`; latency: DDS ping -> bridge -> Zenoh pong -> bridge -> DDS.")
     w("* **ddsperf**: CycloneDDS's `ddsperf` (Debian cyclonedds-tools), `pub`/`sub` and `ping`/`pong`, "

@@ -197,7 +197,10 @@ class RvcPerf:
         port = ctx.port(setting) if self.transport == "zenoh" else 0
         dom = ctx.domain()
         secs = ctx.tput_seconds
-        pub_extra = ["--size", str(size), "--duration", str(secs)] + (["--write-batch"] if self.batch else [])
+        # rvc perf pub batches DDS writes by default (as rvc replay does): the unbatched series asks for one
+        # packet per sample explicitly, so both regimes stay measured.
+        pub_extra = ["--size", str(size), "--duration", str(secs)] + (
+            ["--write-batch"] if self.batch else ["--no-dds-write-batch"] if self.transport == "dds" else [])
         sub = pub = None
         try:
             if setting.inproc:

@@ -37,6 +37,12 @@ struct PerfCommand {
         throw std::invalid_argument("--write-batch needs --transport dds and --rate max");
       if ((name == "pub" || name == "ping") && r.opts.duration <= 0)
         throw std::invalid_argument("rvc perf " + name + ": --duration must be > 0");
+      // A DDS publisher at --rate max packs samples into packets, as ddsperf
+      // does (--no-dds-write-batch: one packet per sample; --dds-config decides for itself).
+#ifdef RVC_HAVE_DDS
+      auto& dds = r.opts.transports.dds;
+      if (name == "pub" && r.opts.rate <= 0 && !dds.write_batch && dds.config_file.empty()) dds.write_batch = true;
+#endif
       install_stop_signals();
       r.opts.should_stop = [] { return stop_requested(); };
       if (name == "pub") return perf::run_pub(r.opts);
@@ -81,7 +87,8 @@ void add_role(PerfCommand& cmd, CLI::App& perf, const std::string& name, const s
   }
   if (name == "pub")
     s->add_flag("--write-batch", r.opts.write_batch,
-                "DDS at max rate: CycloneDDS write batching (several samples per packet, as ddsperf does)");
+                "DDS at max rate: CycloneDDS write batching (several samples per packet, as ddsperf does); the default, "
+                "kept for scripts (--no-dds-write-batch turns it off)");
   if (name == "ping")
     s->add_option("--warmup", r.opts.warmup, "Round trips sent in the first S seconds are not counted")
         ->capture_default_str();

@@ -43,8 +43,15 @@ void add_dds_options(CLI::App& app, transport::DdsOptions& o) {
       ->group(group);
   app.add_option("--dds-trace", o.trace_file, "Write a CycloneDDS trace (config, discovery) to this file")
       ->group(group);
-  app.add_flag("--dds-write-batch", o.write_batch,
-               "Pack several samples per packet (CycloneDDS WriteBatch; flushed when idle and at the end)")
+  // Unset: the command decides (rvc replay, rvc perf pub --rate max: on).
+  CLI::Option* batch = app.add_flag_callback(
+         "--dds-write-batch", [&o] { o.write_batch = true; },
+         "Pack several samples per packet (CycloneDDS WriteBatch; flushed before pauses and at the end). On by "
+         "default for rvc replay and rvc perf pub --rate max")
+      ->group(group);
+  app.add_flag_callback(
+         "--no-dds-write-batch", [&o] { o.write_batch = false; }, "One UDP packet per sample (no WriteBatch)")
+      ->excludes(batch)
       ->group(group);
   app.add_flag_callback(
          "--no-ros2-names", [&o] { o.ros2 = false; },

@@ -110,7 +110,7 @@ class Transport {
       dds_ = o.transports.dds;
       dds_.type = "frame";
       if (o.best_effort) dds_.qos = "best-effort";
-      dds_.write_batch = o.write_batch;
+      if (o.write_batch) dds_.write_batch = true;  // else as the transport flags (rvc perf pub: on)
       return;
 #else
       throw std::invalid_argument("this rvc was built without the dds transport");
@@ -318,6 +318,7 @@ PubResult publish(const PerfOptions& o, transport::Sink& sink, Transport& t) {
       const int64_t due = t0 + static_cast<int64_t>(seq * interval);
       if (due > t) {
         if (due >= deadline) break;
+        sink.idle();  // what write batching holds goes out before the pause
         std::this_thread::sleep_until(at_ns(due));
         t = now_ns();
       }

@@ -31,7 +31,8 @@ struct PerfOptions {
   bool best_effort = false;         // Zenoh: congestion control Drop; DDS: best-effort reliability
   bool inproc = false;              // pub/ping: run the subscriber/pong in this process too
   // DDS pub at max rate: CycloneDDS Internal/WriteBatch (several samples per
-  // packet, as ddsperf does); rvc replay/monitor send each sample at once.
+  // packet, as ddsperf does). rvc perf pub --rate max has it on anyway
+  // (transports.dds.write_batch, unless --no-dds-write-batch).
   bool write_batch = false;
   double timeout = 30;              // hang guard: waiting for a match or the first message
   double idle_timeout = 3;          // sub/pong: stop when nothing arrived for this long

@@ -170,7 +170,7 @@ void validate(const DdsOptions& o) {
     throw std::invalid_argument("--dds-trace cannot be combined with --dds-config: add a <Tracing> section to your file");
   if (!o.config_file.empty() && !o.peers.empty())
     throw std::invalid_argument("--dds-peer cannot be combined with --dds-config: add <Discovery><Peers> to your file");
-  if (!o.config_file.empty() && o.write_batch)
+  if (!o.config_file.empty() && o.write_batch.value_or(false))
     throw std::invalid_argument(
         "--dds-write-batch cannot be combined with --dds-config: add <Internal><WriteBatch>true</WriteBatch></Internal> "
         "to your file");
@@ -244,7 +244,7 @@ std::string generated_config_xml(const DdsOptions& o) {
     x += "      </Peers>\n";
   }
   x += "    </Discovery>\n";
-  if (o.write_batch) x += "    <Internal><WriteBatch>true</WriteBatch></Internal>\n";
+  if (o.write_batch.value_or(false)) x += "    <Internal><WriteBatch>true</WriteBatch></Internal>\n";
   if (!o.trace_file.empty()) {
     x += "    <Tracing>\n";
     x += "      <Category>config,info,discovery</Category>\n";

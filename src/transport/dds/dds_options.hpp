@@ -28,10 +28,14 @@ struct DdsOptions {
   std::string config_file;         // user's CycloneDDS XML: replaces the generated configuration entirely
   std::string trace_file;          // CycloneDDS trace (config, discovery, info) written to this file
   // CycloneDDS Internal/WriteBatch: a writer packs the samples of a burst
-  // into one packet. Sinks also flush explicitly after the end-of-stream
-  // marker, in flush() and idle(). Worth it for bursts of small samples
-  // (rvc replay --rate max).
-  bool write_batch = false;
+  // into one packet instead of one sendmsg per sample (what ddsperf always
+  // does). CycloneDDS never flushes a batch by itself, so sinks flush after
+  // the end-of-stream marker, in flush() and idle(), and the commands that
+  // turn it on call idle() before every pause. Unset: the command decides
+  // (rvc replay and rvc perf pub --rate max: on, measured 0.18 -> 0.9 M
+  // samples/s, docs/performance.md; everything else: off);
+  // --dds-write-batch / --no-dds-write-batch set it. Not with --dds-config.
+  std::optional<bool> write_batch;
   // Set by commands, not by a flag: sources call the handler directly on
   // CycloneDDS's receive thread (a data-available listener) instead of
   // handing samples to a thread of their own. Faster (no wake-up per sample),

@@ -403,7 +403,12 @@ TEST(DdsPubSub, WriteBatchingIsConfigurationAndLosesNothing) {
   o.write_batch = true;
   EXPECT_NE(dds::generated_config_xml(o).find("<Internal><WriteBatch>true</WriteBatch></Internal>"),
             std::string::npos);
-  EXPECT_EQ(dds::generated_config_xml(opts_for(51)).find("WriteBatch"), std::string::npos);
+  EXPECT_EQ(dds::generated_config_xml(opts_for(51)).find("WriteBatch"), std::string::npos);  // unset: off
+  DdsOptions off = opts_for(51);
+  off.write_batch = false;  // --no-dds-write-batch
+  EXPECT_EQ(dds::generated_config_xml(off).find("WriteBatch"), std::string::npos);
+  off.config_file = "/etc/hostname";
+  EXPECT_NO_THROW(dds::validate(off));  // "off" asks nothing of a user's file
   DdsOptions with_file = o;
   with_file.config_file = "/etc/hostname";
   try {

@@ -295,12 +295,21 @@ def test_replay_reaches_a_python_dds_subscriber(rvc, tmp_path, dds_env):
     assert got[len(lines)].startswith("\x04rvc-eos")  # the documented marker, seen by a plain ROS 2 reader
 
 
-def test_replay_with_write_batching_delivers_at_the_publish_rate(rvc, tmp_path, dds_env):
-    """--dds-write-batch packs samples into packets, but a sample published
-    before a pause must not wait for the next one: at a set --rate a subscriber
-    in another process gets every sample when it is published, not all of them
-    with the last packet. (In one process CycloneDDS delivers locally and never
-    batches, so this needs two.)"""
+def write_batch_setting(trace):
+    """CycloneDDS's own account of the configuration it runs with (--dds-trace, category config)."""
+    lines = [l for l in trace.read_text().splitlines() if "config: Domain/Internal/WriteBatch/#text:" in l]
+    assert lines, "no WriteBatch line in the CycloneDDS trace"
+    return lines[-1].split("#text:")[1].split()[0]
+
+
+@pytest.mark.parametrize("flags", [[], ["--dds-write-batch"]], ids=["default", "flag"])
+def test_replay_with_write_batching_delivers_at_the_publish_rate(rvc, tmp_path, dds_env, flags):
+    """rvc replay packs samples into packets (by default, or --dds-write-batch),
+    but a sample published before a pause must not wait for the next one: at a
+    set --rate a subscriber in another process gets every sample when it is
+    published, not all of them with the last packet. (In one process CycloneDDS
+    delivers locally and never batches, so this needs two.) CycloneDDS's trace
+    says batching is really on."""
     from cyclonedds.domain import DomainParticipant
     from cyclonedds.sub import DataReader
     from cyclonedds.topic import Topic
@@ -312,7 +321,7 @@ def test_replay_with_write_batching_delivers_at_the_publish_rate(rvc, tmp_path, 
     dp = DomainParticipant(domain)
     reader = DataReader(dp, Topic(dp, "rt/rvc_py/batched", String_), qos=dds_qos())
     rep = subprocess.Popen([rvc, "replay", str(trace), "--to", "dds:/rvc_py/batched", "--domain", str(domain),
-                            "--rate", "4", "--dds-write-batch", "--no-progress"],
+                            "--rate", "4", "--no-progress", "--dds-trace", str(tmp_path / "trace.txt"), *flags],
                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     got, arrived = [], []
 
@@ -330,3 +339,22 @@ def test_replay_with_write_batching_delivers_at_the_publish_rate(rvc, tmp_path, 
     # Published 0.25 s apart (1.25 s from first to last): held back in one
     # packet until the end of stream they would arrive within milliseconds.
     assert arrived[len(lines) - 1] - arrived[0] > 0.5, [round(t - arrived[0], 3) for t in arrived]
+    assert write_batch_setting(tmp_path / "trace.txt") == "true"
+
+
+def test_replay_no_dds_write_batch_sends_one_packet_per_sample(rvc, tmp_path, dds_env):
+    """--no-dds-write-batch turns the replay's default batching off (CycloneDDS's
+    trace shows the setting it runs with), and --dds-write-batch beside it is refused."""
+    trace = tmp_path / "t.jsonl"
+    trace.write_text("\n".join(messages(3)) + "\n")
+    domain = 200 + os.getpid() % 20
+    run = subprocess.run([rvc, "replay", str(trace), "--to", "dds:/rvc_py/unbatched", "--domain", str(domain),
+                          "--wait-subscribers", "0", "--no-progress", "--no-dds-write-batch",
+                          "--dds-trace", str(tmp_path / "trace.txt")],
+                         capture_output=True, text=True, timeout=HANG_GUARD)
+    assert run.returncode == 0, run.stderr
+    assert write_batch_setting(tmp_path / "trace.txt") == "false"
+    both = subprocess.run([rvc, "replay", str(trace), "--to", "dds:/rvc_py/unbatched", "--domain", str(domain),
+                           "--no-dds-write-batch", "--dds-write-batch"], capture_output=True, text=True,
+                          timeout=HANG_GUARD)
+    assert both.returncode != 0 and "excludes" in both.stderr, both.stderr
