@@ -1,6 +1,7 @@
 #include "io/service_calls.hpp"
 
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 #include <simdjson.h>
@@ -51,7 +52,10 @@ bool ServiceCalls::feed(std::string_view json, std::string& error) {
     out.clear();
     if (doc[field].get_array().get(a) == simdjson::SUCCESS && a.size() > 0) out = simdjson::minify(a.at(0).value());
   };
-  const double t = double(sec) + double(nanosec) * 1e-9;
+  if (sec < INT32_MIN || sec > INT32_MAX || nanosec < 0 || nanosec > 999999999)
+    return reject("info.stamp is out of range (sec int32, nanosec 0..999999999)");
+  const int64_t t_ns = sec * 1000000000 + nanosec;
+  const double t = double(t_ns) / 1e9;
   advance(t);  // a response stamped after the request's deadline comes too late
   Key key{simdjson::minify(gid), sequence};
   const bool request = type <= 1;
@@ -64,6 +68,7 @@ bool ServiceCalls::feed(std::string_view json, std::string& error) {
     Call call;
     call.key = key;
     call.request_time = t;
+    call.request_ns = t_ns;
     call.sequence = sequence;
     first_of("request", call.request);
     Order order{t, arrivals_++};
@@ -86,7 +91,7 @@ bool ServiceCalls::feed(std::string_view json, std::string& error) {
       return true;
     }
     call.answered = true;
-    call.response_time = t;
+    call.response_ns = t_ns;
     first_of("response", call.response);
   }
   flush();
@@ -128,7 +133,7 @@ void ServiceCalls::flush() {
     emitted_any_ = true;
     JsonObject out;
     out.add("time", time).add("request_time", call.request_time).add("answered", call.answered);
-    out.add("latency", call.answered ? call.response_time - call.request_time : timeout_);
+    out.add("latency", call.answered ? double(call.response_ns - call.request_ns) / 1e9 : timeout_);
     out.add("sequence_number", call.sequence);
     if (!call.request.empty()) out.add_raw("request", call.request);
     if (!call.response.empty()) out.add_raw("response", call.response);

@@ -60,11 +60,11 @@ class ServiceCalls {
   using Order = std::tuple<double, uint64_t>;               // request time, arrival
   struct Call {
     Key key;
-    double request_time = 0;
+    double request_time = 0;  // seconds
+    int64_t request_ns = 0, response_ns = 0;  // the stamps, exact: latency = their difference
     int64_t sequence = 0;
     std::string request;   // JSON object or empty
     std::string response;  // JSON object or empty
-    double response_time = 0;
     bool answered = false;
     bool timed_out = false;
   };
