@@ -104,12 +104,8 @@ struct CallsCommand {
       std::fprintf(stderr, "rvc calls: cannot write the output\n");
       return kRuntime;
     }
-    if (c.rejected) return kBadInput;
-    if (c.answered + c.unanswered == 0) {
-      std::fprintf(stderr, "rvc calls: no call was made from the input\n");
-      return kBadInput;
-    }
-    return kOk;
+    if (c.answered + c.unanswered == 0) std::fprintf(stderr, "rvc calls: no call was made from the input\n");
+    return c.rejected || c.answered + c.unanswered == 0 ? kBadInput : kOk;
   }
 };
 
