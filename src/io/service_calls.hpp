@@ -12,8 +12,8 @@
 // "answered": false and "latency": timeout, made when the clock passes that
 // deadline. Calls come out in the order of their request times, each as soon
 // as it and every earlier call is decided; "time" is the request time, moved
-// to 1 ns after the previous call's if the request came later than that call
-// was made (a straggler), so that times always increase.
+// just after the previous call's (1 ns or the next double) if the request
+// came later than that call was made (a straggler), so times always increase.
 #pragma once
 
 #include <cstdint>

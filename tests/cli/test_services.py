@@ -172,3 +172,74 @@ def test_calls_of_the_bag_have_the_latencies_of_its_stamps(rvc, tmp_path):
         want = [(ns(q) / 1e9, (ns(a) - ns(q)) / 1e9) for q, a in zip(ev[0::2], ev[1::2])]
         assert [(c["request_time"], c["latency"]) for c in calls] == want
         assert all(c["answered"] for c in calls)
+
+
+def reference_calls(events, timeout_ns):
+    """The pairing as docs/services.md states it, written again here: (request ns, answered, latency ns)
+    of each call in the order rvc writes them. events: (kind, stamp ns, client, seq) in input order."""
+    now = None
+    calls, open_, made = [], {}, set()   # calls: [req_ns, arrival, answered, resp_ns, decided]
+
+    def decide():
+        for c in calls:
+            if not c[4] and c[0] + timeout_ns <= now:
+                c[4] = True
+    for i, (kind, ns, client, seq) in enumerate(events):
+        now = ns if now is None else max(now, ns)
+        decide()
+        key = (client, seq)
+        if kind <= 1:
+            if key in open_ or key in made:
+                continue
+            c = [ns, i, False, None, False]
+            calls.append(c)
+            open_[key] = c
+        else:
+            c = open_.get(key)
+            if c is None or c[2] or c[4]:
+                continue
+            c[2], c[3], c[4] = True, ns, True
+            made.add(key)
+    out = []
+    for c in sorted(calls, key=lambda c: (c[0], c[1])):
+        if not c[4]:
+            break  # undecided at the end: this and every later call stay pending
+        out.append((c[0], c[2], c[3] - c[0] if c[2] else timeout_ns))
+    return out
+
+
+def test_calls_agree_with_the_stated_rule_on_random_traces(rvc):
+    import random
+    rng = random.Random(28)
+    timeout_ns = 200_000_000
+    for trial in range(40):
+        events, seqs = [], {1: 0, 2: 0}
+        t = 1_700_000_000 * 10**9
+        for _ in range(rng.randint(1, 12)):
+            t += rng.randint(0, 150_000_000)
+            client = rng.choice([1, 2])
+            seqs[client] += 1
+            seq = seqs[client]
+            events.append((0, t, client, seq))
+            if rng.random() < 0.3:
+                events.append((1, t + rng.randint(0, 5_000_000), client, seq))  # the server's side too
+            if rng.random() < 0.8:
+                answer = t + rng.randint(0, 300_000_000)  # some after the 200 ms deadline
+                events.append((3, answer, client, seq))
+                if rng.random() < 0.3:
+                    events.append((2, answer - rng.randint(0, 1_000_000), client, seq))
+        events.sort(key=lambda e: e[1] + rng.randint(-20_000_000, 20_000_000))  # recorded a little out of order
+        lines = [event_line(k, 0, c, s) for k, _, c, s in events]
+        lines = [json.loads(line) for line in lines]
+        for line, (_, ns, _, _) in zip(lines, events):
+            line["info"]["stamp"] = {"sec": ns // 10**9, "nanosec": ns % 10**9}
+        r = run([rvc, "calls", "--service-timeout", "0.2"], stdin="".join(json.dumps(l) + "\n" for l in lines))
+        got = [json.loads(l) for l in r.stdout.splitlines()]
+        want = reference_calls(events, timeout_ns)
+        # request_time is seconds as a double: exact to ~0.2 us at today's epoch; latency is exact
+        assert len(got) == len(want), (trial, events, got)
+        for g, (q, a, lat) in zip(got, want):
+            assert abs(g["request_time"] * 1e9 - q) < 1000 and g["answered"] == a, (trial, events, g)
+            assert round(g["latency"] * 1e9) == lat, (trial, events, g)
+        times = [g["time"] for g in got]
+        assert all(b > a for a, b in zip(times, times[1:])) and all(g["time"] >= g["request_time"] for g in got)
