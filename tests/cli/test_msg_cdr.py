@@ -303,3 +303,33 @@ def test_unknown_type_and_bad_definitions_are_named(rvc, tmp_path):
 def test_constants_are_listed(rvc):
     out = msg(rvc, "show", "autoware_auto_vehicle_msgs/msg/GearReport").stdout
     assert "uint8 REVERSE=20" in out and "uint8 report" in out and "\tint32 sec" in out
+
+
+def test_bundled_definitions_match_the_schemas_of_a_ros2_recorded_bag(rvc, tmp_path):
+    """ROS 2's own test bag (tests/data/ros2-bags/talker_mcap, recorded by rosbag2) carries the full
+    definitions of what it recorded: rcl_interfaces/Log, ParameterEvent and the types they use,
+    std_msgs/String. Each read from the bag (--msg-path) must give the bundled fields; constants may
+    differ in their declared type only (Log's are `byte` in that recording, `uint8` in Jazzy)."""
+    import re
+    reader = pytest.importorskip("mcap.reader")
+    bag = pathlib.Path(__file__).resolve().parent.parent / "data" / "ros2-bags" / "talker_mcap" / "talker.mcap"
+    names = set()
+    with open(bag, "rb") as f:
+        for schema in reader.make_reader(f).get_summary().schemas.values():
+            sections = re.split(r"\n=+\n", schema.data.decode())
+            name = schema.name
+            for i, text in enumerate(sections):
+                if i:
+                    head, _, text = text.partition("\n")
+                    name = head.split("MSG:")[1].strip()
+                pkg, short = name.split("/")[0], name.split("/")[-1]
+                (tmp_path / pkg / "msg").mkdir(parents=True, exist_ok=True)
+                (tmp_path / pkg / "msg" / (short + ".msg")).write_text(text)
+                names.add(f"{pkg}/msg/{short}")
+    assert len(names) >= 6, names
+
+    def shown(*args):
+        lines = msg(rvc, "show", *args).stdout.splitlines()[1:]
+        return [re.sub(r"^(\t*)(byte|uint8) ([A-Z_]+=)", r"\1CONST \3", l) for l in lines]
+    for name in sorted(names):
+        assert shown(name) == shown(name, "--msg-path", str(tmp_path)), name
