@@ -107,6 +107,14 @@ def test_rvc_check_reads_a_service_event_topic_of_a_bag(rvc):
     r = run([rvc, "check", str(SERVICE_BAG), "--topic", "/test_service1/_service_event",
              "--spec", "historically({info.sequence_number >= 1} and {info.client_gid[15] == 3})"])
     assert r.returncode == 0, r.stderr
+    # dense time: each event at its info.stamp
+    r = run([rvc, "check", str(SERVICE_BAG), "--topic", "/test_service1/_service_event", "--dense", "--all",
+             "--spec", "{info.event_type == REQUEST_SENT}"], check=1)
+    verdicts = [json.loads(l) for l in r.stdout.splitlines()]
+    stamps = [e.info.stamp.sec + e.info.stamp.nanosec / 1e9 for e in service1]
+    for e, stamp in zip(service1, stamps):
+        at = [v for v in verdicts if abs(v["time"] - stamp) < 1e-6]
+        assert at and at[0]["value"] == (e.info.event_type == 0), (stamp, verdicts)
     r = run([rvc, "check", str(SERVICE_BAG), "--topic", "/test_service1/_service_event",
              "--spec", "{request[0].nope == 1}"])
     assert r.returncode == 2 and "nope" in r.stderr
