@@ -25,6 +25,7 @@ Runner register_dds_config(CLI::App& app);  // only with the DDS transport
 Runner register_perf(CLI::App& app);
 Runner register_bridge(CLI::App& app);
 Runner register_msg(CLI::App& app);         // ROS 2 message types, CDR <-> JSON
+Runner register_calls(CLI::App& app);       // service events -> one line per call
 Runner register_echo(CLI::App& app);        // print an endpoint's messages as JSON lines
 Runner register_hz(CLI::App& app);          // rate/jitter/silence/latency health check, /diagnostics
 Runner register_sync(CLI::App& app);        // several topics -> one stream of sets

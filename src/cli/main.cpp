@@ -49,7 +49,7 @@ int main(int argc, char** argv) {
       {"check", register_check},   {"timescales", register_timescales}, {"monitor", register_monitor},
       {"replay", register_replay}, {"perf", register_perf},             {"bridge", register_bridge},
       {"msg", register_msg},       {"echo", register_echo},             {"sync", register_sync},
-      {"hz", register_hz},
+      {"hz", register_hz},         {"calls", register_calls},
       {"dashboard", register_dashboard},
 #ifdef RVC_HAVE_ZENOH
       {"router", register_router},

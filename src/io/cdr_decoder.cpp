@@ -108,6 +108,10 @@ std::string CdrDecoder::default_time_field(const MessageType& type, const std::s
     if (const msg::Field* s = field_named(*h->type.message, "stamp"); s && is_stamp(s->type)) return "header.stamp";
   }
   if (const msg::Field* s = field_named(type, "stamp"); s && is_stamp(s->type)) return "stamp";
+  // A service event (pkg/srv/Name_Event, docs/services.md): the time of the event.
+  if (const msg::Field* i = field_named(type, "info"); i && is_single_message(i->type) &&
+                                                       i->type.type_name == "service_msgs/msg/ServiceEventInfo")
+    return "info.stamp";
   return requested;
 }
 

@@ -288,7 +288,8 @@ class Parser {
   std::string scoped(const std::string& name) const {
     return scope_.empty() ? name : join(scope_, scope_.size(), "::") + "::" + name;
   }
-  bool ros_scope() const { return scope_.size() == 2 && scope_[1] == "msg"; }
+  // ROS 2 IDL: module pkg { module msg { ... } } (or srv, for the structs of a service)
+  bool ros_scope() const { return scope_.size() == 2 && (scope_[1] == "msg" || scope_[1] == "srv"); }
 
   void structure() {
     const Token& name_at = cur();
@@ -301,6 +302,7 @@ class Parser {
     m.source = source_;
     if (ros_scope()) {
       m.package = scope_[0];
+      m.kind = scope_[1];
     } else {
       m.package = scope_.empty() ? "" : scope_[0];
       m.idl_name = scoped(name);
@@ -448,8 +450,9 @@ class Parser {
     // or a plain scoped name, found by the registry.
     t.prim = Prim::Message;
     size_t msg = name.find("::msg::");
+    if (msg == std::string::npos) msg = name.find("::srv::");
     if (msg != std::string::npos && name.find("::", msg + 7) == std::string::npos)
-      t.type_name = name.substr(0, msg) + "/msg/" + name.substr(msg + 7);
+      t.type_name = name.substr(0, msg) + "/" + name.substr(msg + 2, 3) + "/" + name.substr(msg + 7);
     else
       t.type_name = name;
     return t;
@@ -600,7 +603,7 @@ std::vector<MessageType> parse_idl(std::string_view text, const std::string& sou
   for (const auto& k : lexer.keylists) {
     MessageType* target = nullptr;
     for (auto& t : types) {
-      std::string scoped = t.idl_name.empty() ? t.package + "::msg::" + t.name : t.idl_name;
+      std::string scoped = t.idl_name.empty() ? t.package + "::" + t.kind + "::" + t.name : t.idl_name;
       if (scoped == k.type || t.name == k.type) target = &t;
     }
     auto fail = [&](const std::string& what) {

@@ -113,8 +113,9 @@ class LineParser {
     } else if (base == "Header") {  // ROS 1 shorthand
       t.type_name = "std_msgs/msg/Header";
     } else if (base.find('/') != std::string_view::npos || base.find("::") != std::string_view::npos) {
-      if (!split_type_name(base, pkg, name)) fail(start, "not a message type name: '" + std::string(base) + "'");
-      t.type_name = pkg + "/msg/" + name;
+      std::string kind;
+      if (!split_type_name(base, pkg, kind, name)) fail(start, "not a message type name: '" + std::string(base) + "'");
+      t.type_name = pkg + "/" + kind + "/" + name;
     } else {
       for (char c : base)
         if (!is_ident(c)) fail(start, "not a type: '" + std::string(base) + "'");
@@ -206,7 +207,7 @@ class LineParser {
 
 }  // namespace
 
-bool split_type_name(std::string_view text, std::string& package, std::string& name) {
+bool split_type_name(std::string_view text, std::string& package, std::string& kind, std::string& name) {
   std::vector<std::string_view> parts;
   std::string_view sep = text.find("::") != std::string_view::npos ? "::" : "/";
   size_t start = 0;
@@ -216,10 +217,14 @@ bool split_type_name(std::string_view text, std::string& package, std::string& n
     if (at == std::string_view::npos) break;
     start = at + sep.size();
   }
-  // pkg/Name, pkg/msg/Name, pkg::msg::Name, pkg::msg::dds_::Name_
-  if (parts.size() == 4 && parts[1] == "msg" && parts[2] == "dds_" && !parts[3].empty() && parts[3].back() == '_') {
+  // pkg/Name, pkg/msg/Name, pkg::msg::Name, pkg::msg::dds_::Name_ (and srv for msg)
+  std::string_view k = "msg";
+  if (parts.size() == 4 && (parts[1] == "msg" || parts[1] == "srv") && parts[2] == "dds_" && !parts[3].empty() &&
+      parts[3].back() == '_') {
+    k = parts[1];
     parts = {parts[0], parts[3].substr(0, parts[3].size() - 1)};
-  } else if (parts.size() == 3 && parts[1] == "msg") {
+  } else if (parts.size() == 3 && (parts[1] == "msg" || parts[1] == "srv")) {
+    k = parts[1];
     parts = {parts[0], parts[2]};
   }
   if (parts.size() != 2) return false;
@@ -229,8 +234,14 @@ bool split_type_name(std::string_view text, std::string& package, std::string& n
       if (!is_ident(c)) return false;
   }
   package = std::string(parts[0]);
+  kind = std::string(k);
   name = std::string(parts[1]);
   return true;
+}
+
+bool split_type_name(std::string_view text, std::string& package, std::string& name) {
+  std::string kind;
+  return split_type_name(text, package, kind, name) && kind == "msg";
 }
 
 MessageType parse_msg(std::string_view package, std::string_view name, std::string_view text,

@@ -19,5 +19,9 @@ MessageType parse_msg(std::string_view package, std::string_view name, std::stri
 // "pkg/msg/Name", "pkg/Name", "pkg::msg::Name" and the DDS form
 // "pkg::msg::dds_::Name_" all give {"pkg", "Name"}; false if `text` is none of them.
 bool split_type_name(std::string_view text, std::string& package, std::string& name);
+// The same, and also the types of a service: "pkg/srv/Name_Request",
+// "pkg::srv::Name_Event", "pkg::srv::dds_::Name_Response_" give kind "srv";
+// every other accepted form gives kind "msg".
+bool split_type_name(std::string_view text, std::string& package, std::string& kind, std::string& name);
 
 }  // namespace rvc::msg

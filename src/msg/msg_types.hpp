@@ -44,7 +44,7 @@ struct MessageType;
 
 struct FieldType {
   Prim prim = Prim::Int32;
-  std::string type_name;                // Message: "pkg/msg/Name"
+  std::string type_name;                // Message: "pkg/msg/Name" (or "pkg/srv/Name_Request")
   const MessageType* message = nullptr; // Message: set by TypeRegistry::resolve
   uint32_t string_bound = 0;            // string<=N; 0: unbounded
   ArrayKind array = ArrayKind::None;
@@ -71,7 +71,11 @@ struct Constant {
 };
 
 struct MessageType {
-  std::string package, name;     // "geometry_msgs", "Twist"
+  std::string package, name;     // "geometry_msgs", "Twist"; a service's "AddTwoInts_Request"
+  // "msg", or "srv" for the types of a service (Name_Request, Name_Response,
+  // Name_Event): the middle of "pkg/srv/Name_Request" and of its DDS name
+  // "pkg::srv::dds_::Name_Request_".
+  std::string kind = "msg";
   // Types from a plain DDS .idl (not in a module pkg::msg): the scoped IDL
   // name ("KeyedSeq", "vehicle::Speed"), which is both its DDS type name and
   // what --type names it by. Empty for ROS 2 types.
@@ -86,7 +90,7 @@ struct MessageType {
   // empty; alignment not counted), set when linked: at most kMaxFixedBytes.
   uint64_t fixed_bytes = 0;
 
-  std::string full_name() const { return idl_name.empty() ? package + "/msg/" + name : idl_name; }
+  std::string full_name() const { return idl_name.empty() ? package + "/" + kind + "/" + name : idl_name; }
   const Constant* constant(const std::string& constant_name) const;
 };
 

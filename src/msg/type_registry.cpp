@@ -8,6 +8,7 @@
 
 #include "msg/idl_parser.hpp"
 #include "msg/msg_parser.hpp"
+#include "msg/service_types.hpp"
 
 namespace rvc::msg {
 
@@ -27,7 +28,14 @@ std::string_view bundled_definition(std::string_view full_name) {
 
 std::vector<std::string> TypeRegistry::bundled_types() {
   std::vector<std::string> out;
-  for (size_t i = 0; i < kBundledCount; ++i) out.emplace_back(kBundled[i].full_name);
+  for (size_t i = 0; i < kBundledCount; ++i) {
+    std::string name = kBundled[i].full_name;
+    if (name.find("/srv/") == std::string::npos) {
+      out.push_back(std::move(name));
+      continue;
+    }
+    for (const char* part : {"_Request", "_Response", "_Event"}) out.push_back(name + part);  // a .srv's three types
+  }
   std::sort(out.begin(), out.end());
   return out;
 }
@@ -111,9 +119,17 @@ void TypeRegistry::scan_idl_files() {
 }
 
 void TypeRegistry::add_definition(const std::string& type_name, std::string text, const std::string& source) {
-  std::string pkg, name;
-  if (!split_type_name(type_name, pkg, name)) throw MsgError(source + ": not a message type name: '" + type_name + "'");
-  added_[pkg + "/msg/" + name] = {std::move(text), source};
+  std::string pkg, kind, name, service;
+  if (!split_type_name(type_name, pkg, kind, name)) throw MsgError(source + ": not a message type name: '" + type_name + "'");
+  ServicePart part;
+  if (kind == "srv" && is_srv_text(text)) {
+    // rosbag2 stores the .srv text as the schema of a service's event topic
+    // (pkg/srv/Name_Event): it defines all three types of the service.
+    if (!split_service_part(name, service, part)) service = name;
+    added_srv_[pkg + "/srv/" + service] = {std::move(text), source};
+    return;
+  }
+  added_[pkg + "/" + kind + "/" + name] = {std::move(text), source};
 }
 
 void TypeRegistry::add_concatenated(const std::string& type_name, std::string_view text, const std::string& source) {
@@ -144,14 +160,15 @@ void TypeRegistry::add_concatenated(const std::string& type_name, std::string_vi
   if (!current_type.empty()) flush();
 }
 
-TypeRegistry::Found TypeRegistry::find_definition(const std::string& package, const std::string& name,
-                                                  std::string& text, std::string& source) {
-  auto added = added_.find(package + "/msg/" + name);
+TypeRegistry::Found TypeRegistry::find_definition(const std::string& package, const std::string& kind,
+                                                  const std::string& name, std::string& text, std::string& source) {
+  auto added = added_.find(package + "/" + kind + "/" + name);
   if (added != added_.end()) {
     text = added->second.first;
     source = added->second.second;
     return Found::Msg;
   }
+  if (kind == "srv") return find_service(package, name, text, source);
   namespace fs = std::filesystem;
   for (const auto& dir : search_paths_) {
     for (const char* ext : {".msg", ".idl"}) {
@@ -178,20 +195,70 @@ TypeRegistry::Found TypeRegistry::find_definition(const std::string& package, co
   return Found::None;
 }
 
+TypeRegistry::Found TypeRegistry::find_service(const std::string& package, const std::string& name, std::string& text,
+                                               std::string& source) {
+  std::string service;
+  ServicePart part;
+  if (!split_service_part(name, service, part)) return Found::None;
+  const std::string srv_key = package + "/srv/" + service;
+  std::string srv_text;
+  bool found = false;
+  if (auto added = added_srv_.find(srv_key); added != added_srv_.end()) {
+    srv_text = added->second.first;
+    source = added->second.second;
+    found = true;
+  }
+  namespace fs = std::filesystem;
+  for (size_t d = 0; !found && d < search_paths_.size(); ++d) {
+    const std::string& dir = search_paths_[d];
+    for (const char* ext : {".srv", ".idl"}) {
+      if (found) break;
+      for (fs::path p : {fs::path(dir) / package / "srv" / (service + ext), fs::path(dir) / "share" / package / "srv" / (service + ext),
+                         fs::path(dir) / package / (service + ext), fs::path(dir) / (service + ext)}) {
+        std::error_code ec;
+        if (!fs::is_regular_file(p, ec)) continue;
+        if (ext[1] == 's') {
+          srv_text = read_file(p);
+          source = p.string();
+          found = true;
+          break;
+        }
+        read_idl_file(p.string());  // rosidl's srv/Name.idl: structs Name_Request and Name_Response
+        if (idl_.count(srv_key + "_Request")) {
+          source = p.string();
+          if (part == ServicePart::Event) return Found::Event;
+          if (idl_.count(package + "/srv/" + name)) return Found::Idl;
+        }
+      }
+    }
+  }
+  if (!found) {
+    std::string_view bundled = bundled_definition(srv_key);
+    if (!bundled.data()) return Found::None;
+    srv_text = std::string(bundled);
+    source = "bundled " + srv_key + ".srv";
+  }
+  if (part == ServicePart::Event) return Found::Event;
+  text = srv_part(srv_text, part, source);
+  return Found::Msg;
+}
+
 const MessageType& TypeRegistry::resolve(std::string_view type_name) {
   const std::string key(type_name);
   if (known(key)) return load(key, 0);
-  std::string pkg, name, text, source;
-  const bool ros = split_type_name(type_name, pkg, name);
+  std::string pkg, kind, name, text, source;
+  const bool ros = split_type_name(type_name, pkg, kind, name);
+  const std::string full = pkg + "/" + kind + "/" + name;
   // "pkg/msg/Name" is always ROS 2; "a::B" may be a ROS 2 pkg::Name or a plain IDL name.
   if (ros && (key.find('/') != std::string::npos || key.find("::msg::") != std::string::npos ||
-              known(pkg + "/msg/" + name) || find_definition(pkg, name, text, source) != Found::None))
-    return load(pkg + "/msg/" + name, 0);
+              key.find("::srv::") != std::string::npos || known(full) ||
+              find_definition(pkg, kind, name, text, source) != Found::None))
+    return load(full, 0);
   scan_idl_files();
   if (known(key)) return load(key, 0);
-  if (ros && key.find("::") == std::string::npos) return load(pkg + "/msg/" + name, 0);  // the usual error
+  if (ros && key.find("::") == std::string::npos) return load(full, 0);  // the usual error
   throw MsgError("unknown message type '" + key + "': no .idl file of --msg-path defines it" +
-                 (ros ? ", and there is no ROS 2 type " + pkg + "/msg/" + name : std::string()) + idl_scan_errors_);
+                 (ros ? ", and there is no ROS 2 type " + full : std::string()) + idl_scan_errors_);
 }
 
 const MessageType& TypeRegistry::load(const std::string& key, int depth) {
@@ -202,18 +269,29 @@ const MessageType& TypeRegistry::load(const std::string& key, int depth) {
   }
   if (depth > 64) throw MsgError("message types nested deeper than 64 levels at " + key);
   std::unique_ptr<MessageType> type;
-  std::string pkg, name, text, source;
+  std::string pkg, kind, name, text, source;
   if (!idl_.count(key) && key.find('/') == std::string::npos) scan_idl_files();  // a plain IDL name
   if (auto idl = idl_.find(key); idl != idl_.end()) {
     type = std::make_unique<MessageType>(idl->second);
-  } else if (key.find('/') != std::string::npos && split_type_name(key, pkg, name)) {
-    switch (find_definition(pkg, name, text, source)) {
-      case Found::Msg: type = std::make_unique<MessageType>(parse_msg(pkg, name, text, source)); break;
+  } else if (key.find('/') != std::string::npos && split_type_name(key, pkg, kind, name)) {
+    switch (find_definition(pkg, kind, name, text, source)) {
+      case Found::Msg:
+        type = std::make_unique<MessageType>(parse_msg(pkg, name, text, source));
+        type->kind = kind;
+        break;
       case Found::Idl: type = std::make_unique<MessageType>(idl_.at(key)); break;
+      case Found::Event: {
+        std::string service;
+        ServicePart part;
+        split_service_part(name, service, part);
+        type = std::make_unique<MessageType>(service_event_type(pkg, service, source));
+        break;
+      }
       case Found::None: {
         std::string where = search_paths_.empty() ? "no --msg-path given" : "searched --msg-path";
         for (const auto& d : search_paths_) where += " " + d;
-        throw MsgError("unknown message type " + key + ": not bundled with rvc, not in a bag schema, " + where);
+        throw MsgError("unknown message type " + key + ": not bundled with rvc, not in a bag schema, " + where +
+                       (kind == "srv" ? " (a service's types come from its .srv: pkg/srv/Name.srv)" : ""));
       }
     }
   } else {

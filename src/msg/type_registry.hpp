@@ -1,7 +1,7 @@
 // Finds, parses and links ROS 2 message types by name, from (in this order)
 // definitions added in-process (an MCAP bag's schemas), folders given with
-// --msg-path, and the definitions bundled with rvc (builtin_interfaces,
-// std_msgs, geometry_msgs and the Autoware messages of the paper's Table 3).
+// --msg-path, and the definitions bundled with rvc (ROS 2's common_interfaces
+// and services, the Autoware messages of the paper's Table 3).
 // Definitions are ROS 2 .msg files or OMG IDL (.idl, see idl_parser.hpp):
 // ROS 2 types by pkg/msg/Name, plain DDS IDL types by their scoped name.
 #pragma once
@@ -38,7 +38,8 @@ class TypeRegistry {
   void add_concatenated_idl(std::string_view text, const std::string& source);
 
   // The type and every type it uses, parsed and linked. Accepts "pkg/msg/Name",
-  // "pkg/Name", the DDS name "pkg::msg::dds_::Name_" and plain IDL names
+  // "pkg/Name", the DDS name "pkg::msg::dds_::Name_", a service's types
+  // "pkg/srv/Name_Request" / "_Response" / "_Event" (pkg::srv::dds_::Name_Request_), and plain IDL names
   // ("KeyedSeq", "vehicle::Speed"; these are looked for in every .idl file
   // of the search folders). Throws MsgError.
   const MessageType& resolve(std::string_view type_name);
@@ -47,11 +48,14 @@ class TypeRegistry {
   static std::vector<std::string> bundled_types();
 
  private:
-  enum class Found { None, Msg, Idl };
+  enum class Found { None, Msg, Idl, Event };  // Event: a service's Name_Event, made from its .srv
   const MessageType& load(const std::string& key, int depth);
   bool known(const std::string& key) const { return types_.count(key) || idl_.count(key); }
   // .msg text (Msg), or an .idl file now in idl_ (Idl), in the registry's order.
-  Found find_definition(const std::string& package, const std::string& name, std::string& text, std::string& source);
+  // For "srv" types: `text` is the request or response part of the .srv.
+  Found find_definition(const std::string& package, const std::string& kind, const std::string& name, std::string& text,
+                        std::string& source);
+  Found find_service(const std::string& package, const std::string& name, std::string& text, std::string& source);
   void read_idl_file(const std::string& path);
   void scan_idl_files();
 
@@ -61,6 +65,7 @@ class TypeRegistry {
   bool idl_scanned_ = false;
   std::string idl_scan_errors_;
   std::map<std::string, std::pair<std::string, std::string>> added_;  // full name -> (text, source)
+  std::map<std::string, std::pair<std::string, std::string>> added_srv_;  // "pkg/srv/Name" -> (.srv text, source)
   std::map<std::string, std::unique_ptr<MessageType>> types_;        // full name -> linked type
 };
 

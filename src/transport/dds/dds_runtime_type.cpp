@@ -259,7 +259,7 @@ class OpsBuilder {
 
 std::string ros2_dds_type_name(const MessageType& type) {
   if (!type.idl_name.empty()) return type.idl_name;  // a plain DDS IDL type keeps its own name
-  return type.package + "::msg::dds_::" + type.name + "_";
+  return type.package + "::" + type.kind + "::dds_::" + type.name + "_";  // pkg::srv::dds_::X_Request_ too
 }
 
 RuntimeTopicType::RuntimeTopicType(const MessageType& type) : type_name_(ros2_dds_type_name(type)) {

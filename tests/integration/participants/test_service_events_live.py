@@ -1,0 +1,117 @@
+"""Service introspection events live over DDS: a cyclonedds-Python participant (pinned to loopback)
+publishes std_srvs/srv/SetBool_Event samples on rt/set_bool/_service_event under the DDS type name
+rosidl gives them (std_srvs::srv::dds_::SetBool_Event_); `rvc echo --type std_srvs/srv/SetBool_Event`
+reads them and `rvc calls --wall` pairs them: an answered call with the latency of its stamps, and a
+request never answered reported at its deadline while the topic is still open (the system clock moves
+time, no further event needed)."""
+import json
+import os
+import select
+import signal
+import subprocess
+import time
+
+import pytest
+
+from conftest import transports_built
+from ros_idl_types import loopback_dds
+from rvc_testlib import dds_matched
+from test_python_peers import HANG_GUARD, wait_for
+
+
+def set_bool_event_types():
+    from dataclasses import dataclass
+
+    from cyclonedds.idl import IdlStruct
+    from cyclonedds.idl.types import array, int32, int64, sequence, uint8, uint32
+
+    @dataclass
+    class Time_(IdlStruct, typename="builtin_interfaces::msg::dds_::Time_"):
+        sec: int32
+        nanosec: uint32
+
+    @dataclass
+    class ServiceEventInfo_(IdlStruct, typename="service_msgs::msg::dds_::ServiceEventInfo_"):
+        event_type: uint8
+        stamp: Time_
+        client_gid: array[uint8, 16]  # char[16] in the .msg: one octet each
+        sequence_number: int64
+
+    @dataclass
+    class SetBool_Request_(IdlStruct, typename="std_srvs::srv::dds_::SetBool_Request_"):
+        data: bool
+
+    @dataclass
+    class SetBool_Response_(IdlStruct, typename="std_srvs::srv::dds_::SetBool_Response_"):
+        success: bool
+        message: str
+
+    @dataclass
+    class SetBool_Event_(IdlStruct, typename="std_srvs::srv::dds_::SetBool_Event_"):
+        info: ServiceEventInfo_
+        request: sequence[SetBool_Request_, 1]
+        response: sequence[SetBool_Response_, 1]
+
+    return Time_, ServiceEventInfo_, SetBool_Request_, SetBool_Response_, SetBool_Event_
+
+
+def read_line(proc, deadline_s=HANG_GUARD):
+    end = time.time() + deadline_s
+    while time.time() < end:
+        ready, _, _ = select.select([proc.stdout], [], [], 0.1)
+        if ready:
+            return proc.stdout.readline()
+    raise AssertionError("no line from rvc calls")
+
+
+def test_service_events_over_dds_become_calls(rvc, tmp_path, monkeypatch):
+    if "dds" not in transports_built(rvc):
+        pytest.skip("rvc built without DDS")
+    loopback_dds(rvc, tmp_path, monkeypatch)  # before any Python participant exists
+    pytest.importorskip("cyclonedds")
+    from cyclonedds.domain import DomainParticipant
+    from cyclonedds.pub import DataWriter
+    from cyclonedds.qos import Policy, Qos
+    from cyclonedds.topic import Topic
+    from cyclonedds.util import duration
+    Time_, Info_, Req_, Resp_, Event_ = set_bool_event_types()
+    domain = 150 + os.getpid() % 50
+    echo = subprocess.Popen([rvc, "echo", "dds:/set_bool/_service_event", "--type", "std_srvs/srv/SetBool_Event",
+                             "--domain", str(domain)], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    calls = subprocess.Popen([rvc, "calls", "--service-timeout", "2", "--wall"], stdin=echo.stdout,
+                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    echo.stdout.close()
+    try:
+        dp = DomainParticipant(domain)
+        qos = Qos(Policy.Reliability.Reliable(duration(seconds=30)), Policy.History.KeepAll,
+                  Policy.Durability.Volatile)
+        writer = DataWriter(dp, Topic(dp, "rt/set_bool/_service_event", Event_), qos=qos)
+        wait_for(lambda: dds_matched(writer), "rvc echo to match the service event topic")
+        now_ns = time.time_ns()
+
+        def info(kind, ns, client, seq):
+            return Info_(event_type=kind, stamp=Time_(sec=ns // 10**9, nanosec=ns % 10**9),
+                         client_gid=[client] + [0] * 15, sequence_number=seq)
+        writer.write(Event_(info=info(0, now_ns, 1, 1), request=[Req_(data=True)], response=[]))
+        writer.write(Event_(info=info(1, now_ns + 1_000_000, 1, 1), request=[Req_(data=True)], response=[]))
+        writer.write(Event_(info=info(2, now_ns + 40_000_000, 1, 1), request=[],
+                            response=[Resp_(success=True, message="set")]))
+        writer.write(Event_(info=info(0, now_ns + 100_000_000, 2, 1), request=[Req_(data=False)], response=[]))
+        first = json.loads(read_line(calls))
+        assert first["answered"] is True and first["latency"] == 0.04
+        assert first["request"] == {"data": True} and first["response"] == {"success": True, "message": "set"}
+        # client 2's request is never answered: made by the clock, with rvc echo still running
+        second = json.loads(read_line(calls))
+        assert echo.poll() is None
+        assert second["answered"] is False and second["latency"] == 2 and second["request"] == {"data": False}
+        assert second["request_time"] == (now_ns + 100_000_000) / 1e9
+        echo.send_signal(signal.SIGINT)
+        out, err = calls.communicate(timeout=HANG_GUARD)
+        assert out == ""
+        assert calls.returncode == 0, err
+        assert "4 events: 2 calls (1 answered, 1 unanswered after 2s)" in err and "1 duplicate" in err, err
+        echo.wait(timeout=HANG_GUARD)
+    finally:
+        for p in (echo, calls):
+            if p.poll() is None:
+                p.kill()
