@@ -146,6 +146,13 @@ struct EchoCommand {
       std::fprintf(stderr, "rvc: --topic chooses a topic of a bag (bag:PATH, a .mcap or .db3 file, a bag folder)\n");
       return kUsage;
     }
+    if (transport::scheme_of(input) == "file" && input != "-") {  // a file's lines are printed as they are
+      const std::string path = input.rfind("file:", 0) == 0 ? input.substr(5) : input;
+      if (const std::string what = transport::binary_signature(path); !what.empty()) {
+        std::fprintf(stderr, "rvc: input '%s' is %s, not JSON lines\n", path.c_str(), what.c_str());
+        return kUsage;
+      }
+    }
     if (typed.given() && !TypeOptions::typed_scheme(input)) {
       std::fprintf(stderr, "rvc: --type reads dds: or zenoh: inputs; for CDR in a file use `rvc msg decode`\n");
       return kUsage;

@@ -22,7 +22,11 @@ namespace {
 constexpr char kMcapMagic[] = "\x89MCAP0\r\n";
 constexpr char kSqliteMagic[] = "SQLite format 3";  // and a NUL: the file's first 16 bytes
 
+// The first bytes of a regular file; "" for anything else: a pipe or a
+// device (/dev/stdin) is never read here, its bytes belong to the run.
 std::string head_of(const std::string& path, size_t n) {
+  struct stat st{};
+  if (::stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) return "";
   std::ifstream in(path, std::ios::binary);
   std::string head(n, '\0');
   in.read(head.data(), static_cast<std::streamsize>(n));
@@ -209,6 +213,10 @@ void summarize_file(const std::string& path, BagSummary& s, std::map<std::string
   if (is_zstd_frame(head_of(path, 4))) {
     copy = std::make_unique<ZstdFileCopy>(path);
     file = copy->path();
+  }
+  if (copy && s.compression_format.empty()) {  // a compressed file given alone: no metadata.yaml says so
+    s.compression_format = "zstd";
+    s.compression_mode = "file";
   }
   switch (file_kind(head_of(file, 16))) {
     case BagKind::Sqlite: {
