@@ -81,7 +81,7 @@ BagInput select_bag_topic(const std::string& path, const std::string& topic, msg
                                 "': rvc reads ROS 2 CDR and JSON messages");
   if (t.type.empty())
     throw std::invalid_argument("topic '" + in.topic + "' of bag '" + path +
-                                "' has no type: the bag does not say which type its CDR messages are");
+                                "' has no schema (no type): the bag does not say which type its CDR messages are");
   // A bag may name the type and hold no definition (sqlite3 bags before
   // Iron, some writers): then the type comes from --msg-path or the bundled
   // definitions, as does any type a definition uses but leaves out. A type

@@ -28,7 +28,8 @@ TOPICS = [
     ("cdr_test", "/test_topic"), ("cdr_test", "/array_topic"),
     ("services", "/test_topic1"), ("services", "/test_topic2"),
 ]
-STORAGES = ["sqlite3", "mcap"]
+# MCAP needs rvc's Rust library: deselected where it is not built (RVC_NO_RUST, conftest.py).
+STORAGES = ["sqlite3", pytest.param("mcap", marks=pytest.mark.needs_rust)]
 
 
 def run(args, **kw):
@@ -239,6 +240,7 @@ def humble():
     return get_typestore(Stores.ROS2_HUMBLE)
 
 
+@pytest.mark.needs_rust
 @pytest.mark.parametrize("compression", [None, "file", "message"])
 def test_db3_and_mcap_twins_give_identical_verdicts(rvc, humble, tmp_path, compression):
     if "zenoh" not in transports_built(rvc):
@@ -246,6 +248,7 @@ def test_db3_and_mcap_twins_give_identical_verdicts(rvc, humble, tmp_path, compr
     from rosbags.rosbag2 import CompressionMode
     mode = {None: None, "file": CompressionMode.FILE, "message": CompressionMode.MESSAGE}[compression]
     bags, speeds = write_twins(tmp_path, humble, mode)
+    start = os.path.getmtime(tmp_path) - 1  # decompressed copies rvc makes are removed: none newer than this
     # Oracle: the same speeds as JSON lines through `rvc check`.
     trace = tmp_path / "speeds.jsonl"
     trace.write_text("".join(json.dumps({"time": i, "data": v}) + "\n" for i, v in enumerate(speeds)))
@@ -271,6 +274,15 @@ def test_db3_and_mcap_twins_give_identical_verdicts(rvc, humble, tmp_path, compr
         info = json.loads(run([rvc, "bag", "info", target, "--json"]).stdout)
         assert info["compression_mode"] == (compression or "")
         outs[storage] = (c.stdout, s.stdout)
+        if compression == "file":  # the compressed storage file alone (x.db3.zstd, x.mcap.zstd): the same
+            alone = [os.path.join(path, f) for f in os.listdir(path) if f.endswith(".zstd")]
+            assert len(alone) == 1
+            a = run([rvc, "check", alone[0], "--topic", "/speed", "--spec", spec])
+            assert a.returncode == 1 and a.stdout == c.stdout, a.stderr
+            ai = json.loads(run([rvc, "bag", "info", alone[0], "--json"]).stdout)
+            assert (ai["compression_format"], ai["compression_mode"], ai["messages"]) == ("zstd", "file", 9)
+            assert not [f for f in os.listdir(os.environ.get("TMPDIR", "/tmp")) if f.startswith("rvc-bag-")
+                        and os.path.getmtime(os.path.join(os.environ.get("TMPDIR", "/tmp"), f)) > start]
     assert outs["sqlite3"] == outs["mcap"]
     # Verdict times are the messages' positions in the speed topic: the same as the JSON trace's.
     assert [json.loads(x)["value"] for x in outs["sqlite3"][0].splitlines()] == \
@@ -352,3 +364,39 @@ def test_a_fifo_is_read_as_json_lines_not_sniffed(rvc, tmp_path):
     out, err = p.communicate(timeout=60)
     assert p.returncode == 1, err
     assert [json.loads(x)["value"] for x in out.splitlines()] == [True, False]
+
+
+@pytest.mark.parametrize("storage", STORAGES)
+def test_end_of_recording_tick_on_every_storage(rvc, tmp_path, storage):
+    """test_clock_end's recording (gear reports 2 until 1.0 s, steering goes on to 3.0 s) as a db3 bag
+    and as MCAP: the tick at the recording's end reports once[0:0.5] falling at 1.5 (by hand), through
+    `rvc check` and `rvc monitor --input bag:`, the same on both storages."""
+    from rosbags.rosbag2 import StoragePlugin, Writer
+    from rosbags.typesys import Stores, get_typestore
+    from rosbags.typesys.msg import get_types_from_msg
+    defs = os.path.join(ROOT, "src", "msg", "definitions")
+    gear, steer = "autoware_auto_vehicle_msgs/msg/GearReport", "autoware_auto_vehicle_msgs/msg/SteeringReport"
+    ts = get_typestore(Stores.ROS2_HUMBLE)
+    for name in (gear, steer):
+        with open(os.path.join(defs, name.split("/")[0], "msg", name.split("/")[-1] + ".msg")) as f:
+            ts.register(get_types_from_msg(f.read(), name))
+    Time = ts.types["builtin_interfaces/msg/Time"]
+    t0 = 1_700_000_000 * 10**9
+    ns = lambda s: int(round(s * 1e9))  # noqa: E731
+    folder = tmp_path / f"silent_gear_{storage}"
+    plugin = StoragePlugin.SQLITE3 if storage == "sqlite3" else StoragePlugin.MCAP
+    with Writer(folder, version=8, storage_plugin=plugin) as w:
+        cg, cs = w.add_connection("/gear", gear, typestore=ts), w.add_connection("/steer", steer, typestore=ts)
+        events = [(s, cg, gear, ts.types[gear](stamp=Time(sec=int(s), nanosec=ns(s % 1)), report=r))
+                  for s, r in [(0.25, 2), (0.5, 2), (0.75, 2), (1.0, 20)]]
+        events += [(s, cs, steer, ts.types[steer](stamp=Time(sec=int(s), nanosec=ns(s % 1)), steering_tire_angle=0.0))
+                   for s in [0.5 * k for k in range(1, 7)]]
+        for s, conn, name, msg in sorted(events, key=lambda e: e[0]):
+            w.write(conn, t0 + ns(s), ts.serialize_cdr(msg, name))
+    spec = "once[0:0.5]{report == 2}"
+    c = run([rvc, "check", "--dense", "--topic", "/gear", "--spec", spec, str(folder)])
+    m = run([rvc, "monitor", "--dense", "--input", f"bag:{folder}", "--topic", "/gear", "--spec", spec])
+    want = [(0, False), (0.25, True), (1.5, False)]
+    for r in (c, m):
+        assert r.returncode == 1, r.stderr
+        assert [(v["time"], v["value"]) for v in map(json.loads, r.stdout.splitlines())] == want
