@@ -116,10 +116,10 @@ bool SqliteBag::has_table(const char* name) const {
   Statement st;
   if (sqlite3_prepare_v2(db_, "SELECT 1 FROM sqlite_master WHERE type = 'table' AND name = ?", -1, &st.s, nullptr) !=
       SQLITE_OK)
-    fail(std::string("not a rosbag2 bag: SQLite says: ") + sqlite3_errmsg(db_));
+    fail(std::string("SQLite cannot read it: ") + sqlite3_errmsg(db_));
   sqlite3_bind_text(st.s, 1, name, -1, SQLITE_STATIC);
   const int rc = sqlite3_step(st.s);
-  if (rc != SQLITE_ROW && rc != SQLITE_DONE) fail(std::string("not a rosbag2 bag: SQLite says: ") + sqlite3_errmsg(db_));
+  if (rc != SQLITE_ROW && rc != SQLITE_DONE) fail(std::string("SQLite cannot read it: ") + sqlite3_errmsg(db_));
   return rc == SQLITE_ROW;
 }
 
