@@ -138,7 +138,7 @@ def test_echo_gives_rosbags_values(rvc, name, topic, storage):
     want = rosbags_messages(folder, topic)
     assert want, "the oracle read nothing"
     # The folder, the storage file alone, and bag:FILE: the same messages.
-    for target in (folder, storage_file(folder), "bag:" + storage_file(folder)):
+    for target in (folder, storage_file(folder), "bag:" + storage_file(folder), "mcap:" + folder):
         r = run([rvc, "echo", target, "--topic", topic, "--msg-path", MSGS])
         assert r.returncode == 0, (target, r.stderr)
         got = [json.loads(line) for line in r.stdout.splitlines()]
@@ -289,14 +289,17 @@ def test_db3_and_mcap_twins_give_identical_verdicts(rvc, humble, tmp_path, compr
            [json.loads(x)["value"] for x in want.stdout.splitlines()]
 
 
-def test_split_bag_folder_is_merged_in_log_time(rvc, humble, tmp_path):
-    """Two db3 files of one bag, their messages interleaved in time: read as one, in log-time order."""
+@pytest.mark.parametrize("storage", STORAGES)
+def test_split_bag_folder_is_merged_in_log_time(rvc, humble, tmp_path, storage):
+    """Two storage files of one bag, their messages interleaved in time: read as one, in log-time order."""
     from rosbags.rosbag2 import StoragePlugin, Writer
     Float64 = humble.types["std_msgs/msg/Float64"]
+    ext = ".db3" if storage == "sqlite3" else ".mcap"
+    plugin = StoragePlugin.SQLITE3 if storage == "sqlite3" else StoragePlugin.MCAP
     parts = []
     for k in range(2):
         p = tmp_path / f"part{k}"
-        with Writer(p, version=8, storage_plugin=StoragePlugin.SQLITE3) as w:
+        with Writer(p, version=8, storage_plugin=plugin) as w:
             c = w.add_connection("/x", Float64.__msgtype__, typestore=humble)
             for i in range(k, 10, 2):  # part0: 0,2,4..; part1: 1,3,5..
                 w.write(c, 1_000 + i, humble.serialize_cdr(Float64(data=float(i)), Float64.__msgtype__))
@@ -304,11 +307,11 @@ def test_split_bag_folder_is_merged_in_log_time(rvc, humble, tmp_path):
     bag = tmp_path / "split"
     bag.mkdir()
     for k, p in enumerate(parts):
-        shutil.copy(next(p.glob("*.db3")), bag / f"split_{k}.db3")
+        shutil.copy(next(p.glob("*" + ext)), bag / f"split_{k}{ext}")
     import yaml
     md = yaml.safe_load((parts[0] / "metadata.yaml").read_text())
     info = md["rosbag2_bagfile_information"]
-    info["relative_file_paths"] = ["split_0.db3", "split_1.db3"]
+    info["relative_file_paths"] = ["split_0" + ext, "split_1" + ext]
     info["message_count"] = 10
     (bag / "metadata.yaml").write_text(yaml.safe_dump(md))
     r = run([rvc, "echo", str(bag), "--topic", "/x"])

@@ -184,6 +184,7 @@ def test_corrupted_db3_never_crashes(rvc, tmp_path):
             r = run([rvc, *args])
             assert r.returncode in (0, 1, 2, 3, 6), (k, args, r.returncode, r.stderr[-500:])
             seen.add(r.returncode)
+            assert "invalid JSON" not in r.stderr, (k, args, r.stderr[-500:])  # read as a bag, never as text
             if r.returncode not in (0, 1):
                 assert r.stderr.strip(), (k, args)
     assert 2 in seen or 3 in seen  # the damage was noticed at least once
