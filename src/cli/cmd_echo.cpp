@@ -133,6 +133,7 @@ struct EchoCommand {
       return kRuntime;
     }
     if (rejected > 0) {
+      if (printed == 0) runtime::hint_bag_definition(in);
       std::fprintf(stderr, "rvc echo: %llu message%s of the bag could not be read or decoded\n",
                    static_cast<unsigned long long>(rejected), rejected == 1 ? "" : "s");
       return kBadInput;

@@ -89,6 +89,7 @@ BagInput select_bag_topic(const std::string& path, const std::string& topic, msg
   const bool defined = t.definition.find_first_not_of(" \t\r\n") != std::string::npos;
   const std::string source = "definition of " + in.topic + " in " + path;
   if (defined && !in_search_paths(registry, t.type)) {
+    in.bag_definition = t.definition_encoding == "ros2msg" || t.definition_encoding == "ros2idl";
     if (t.definition_encoding == "ros2msg")
       registry.add_concatenated(t.type, t.definition, source);
     else if (t.definition_encoding == "ros2idl")  // types defined in .idl only (rosbag2 records them so)
@@ -99,6 +100,14 @@ BagInput select_bag_topic(const std::string& path, const std::string& topic, msg
   }
   in.type = &registry.resolve(t.type);
   return in;
+}
+
+void hint_bag_definition(const BagInput& in) {
+  if (!in.bag_definition || !in.type) return;
+  std::fprintf(stderr,
+               "rvc: no message of %s decoded with the definition of %s that bag '%s' records: if that definition is "
+               "wrong or cut short, give the type's .msg with --msg-path DIR (docs/bags.md)\n",
+               in.topic.c_str(), in.type->full_name().c_str(), in.path.c_str());
 }
 
 Outcome check_bag(const std::vector<BagInput>& inputs, Feed& feed, VerdictOutputs& outputs, uint64_t& skipped,

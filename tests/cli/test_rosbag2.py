@@ -203,6 +203,12 @@ def test_talker_db3_stand_in_definition_needs_msg_path(rvc):
     with_defs = run([rvc, "echo", db3, "--topic", "/rosout", "--msg-path", MSGS, "--count", "1"])
     assert with_defs.returncode == 0, with_defs.stderr
     assert set(json.loads(with_defs.stdout)) == {"stamp", "level", "name", "msg", "file", "function", "line"}
+    # Without it: every sample has bytes left over after `level`, so none is printed as if it were a
+    # Log; rvc says the recorded definition may be wrong and how to give the right one.
+    for args in (["echo", db3, "--topic", "/rosout"], ["check", db3, "--topic", "/rosout", "--spec", "{level < 30}"]):
+        r = run([rvc, *args])
+        assert r.returncode == (3 if args[0] == "echo" else 6) and r.stdout == "", (args, r.returncode, r.stderr)
+        assert "bytes left over" in r.stderr and "give the type's .msg with --msg-path DIR" in r.stderr, r.stderr
 
 
 # --- generated twins: a db3 bag and its MCAP twin give identical verdicts ----------------------------
