@@ -23,6 +23,7 @@ APT_PACKAGES=(
   build-essential cmake ninja-build pkg-config git ccache
   libsimdjson-dev libcli11-dev libyaml-cpp-dev libgtest-dev libgmock-dev libbenchmark-dev
   libsqlite3-dev libpq-dev              # results store: SQLite embedded, libpq's header (loaded on use)
+  libzstd-dev                           # ROS 2 bags compressed by rosbag2 (zstd per file or per message)
   libcpp-httplib-dev                    # rvc dashboard's HTTP server
   cyclonedds-dev cyclonedds-tools       # DDS transport (idlc generates its type support)
   python3

@@ -26,7 +26,8 @@ BagRun run_bag(const std::string& path, const std::vector<std::string>& topics,
     run.stats = pipeline.stats();
     run.stats.rejected += skipped;  // the bag's bad records: rejected input like a malformed message
     run.violations = pipeline.violations();
-    run.received = pipeline.received();
+    run.received = pipeline.received() + skipped;  // a bad record was read and rejected: counts add up
+    if (run.stats.accepted == 0 && run.stats.rejected > 0) runtime::hint_bag_definition(bag);
     return run;
   }
   std::vector<runtime::BagInput> bags;
@@ -47,7 +48,7 @@ BagRun run_bag(const std::string& path, const std::vector<std::string>& topics,
   run.stats = pipeline.stats();
   run.stats.rejected += skipped;
   run.violations = pipeline.violations();
-  run.received = pipeline.received();
+  run.received = pipeline.received() + skipped;
   pipeline.add_dropped(run.dropped);
   return run;
 }

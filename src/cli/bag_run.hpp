@@ -19,7 +19,7 @@ struct BagRun {
   runtime::PipelineStats stats;
   uint64_t violations = 0;
   uint64_t messages = 0;    // of the chosen topics
-  uint64_t received = 0;    // of those, given to the pipeline (all of them unless the bag broke off)
+  uint64_t received = 0;    // of those, read (all of them unless the bag broke off), damaged records included
   io::JsonObject dropped;   // by the synchronizer, by reason
   std::string topic;        // the chosen topic (several: joined by ",")
   std::string description;  // "topic /a (pkg/msg/T, 12 messages)", or the inputs

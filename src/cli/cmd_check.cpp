@@ -16,11 +16,9 @@
 #include "cli/sync_options.hpp"
 #include "msg/type_registry.hpp"
 #include "runtime/check_stream.hpp"
-#ifdef RVC_HAVE_MCAP
 #include "cli/bag_run.hpp"
 #include "runtime/check_bag.hpp"
-#include "transport/mcap/mcap_bag.hpp"
-#endif
+#include "transport/rosbag2/bag_reader.hpp"
 #include "transport/file_endpoint.hpp"
 
 namespace rvc::cli {
@@ -56,10 +54,19 @@ struct CheckCommand {
       std::fprintf(stderr, "rvc: --output '%s' is the trace being read: refusing to overwrite it\n", opath.c_str());
       return kUsage;
     }
-    const bool bag = input.rfind("mcap:", 0) == 0;
-    if (bag || (path != "-" && is_bag(path))) return run_bag(properties, bag ? input.substr(5) : path, opath);
+    // A bag: named so (bag:PATH, mcap:PATH) or found by its content (an MCAP
+    // or rosbag2 sqlite3 file, a folder with metadata.yaml), as `ros2 bag` takes it.
+    const bool bag = input.rfind("mcap:", 0) == 0 || input.rfind("bag:", 0) == 0;
+    if (bag || (path != "-" && transport::is_bag(path)))
+      return run_bag(properties, bag ? input.substr(input.find(':') + 1) : path, opath);
+    if (path != "-")
+      if (const std::string what = transport::binary_signature(path); !what.empty()) {
+        std::fprintf(stderr, "rvc: trace '%s' is %s, not JSON lines (rvc check reads JSON lines and ROS 2 bags)\n",
+                     path.c_str(), what.c_str());
+        return kUsage;
+      }
     if (!topics.empty() || !msg_paths.empty()) {
-      std::fprintf(stderr, "rvc: %s a bag (MCAP); '%s' is a JSON-lines trace\n",
+      std::fprintf(stderr, "rvc: %s a bag (MCAP, sqlite3 or a bag folder); '%s' is a JSON-lines trace\n",
                    topics.empty() ? "--msg-path gives the message definitions of" : "--topic chooses a topic of",
                    path.c_str());
       return kUsage;
@@ -115,19 +122,9 @@ struct CheckCommand {
     return outcome.exit_code();
   }
 
-  static bool is_bag(const std::string& path) {
-#ifdef RVC_HAVE_MCAP
-    return transport::McapBag::looks_like_mcap(path);
-#else
-    (void)path;
-    return false;
-#endif
-  }
-
   // A ROS 2 bag: its types from the bag's own schemas.
   int run_bag(const std::vector<engine::PropertySpec>& properties, const std::string& path,
               const std::string& opath) {
-#ifdef RVC_HAVE_MCAP
     for (const auto& dir : msg_paths) registry.add_search_path(dir);
     std::vector<std::unique_ptr<transport::Sink>> sinks;
     sinks.push_back(std::make_unique<transport::FileSink>(opath));
@@ -147,13 +144,6 @@ struct CheckCommand {
     if (stats) std::fprintf(stderr, "%s\n", run.counters_json(input, outputs.count()).c_str());
     if (results) results->finish(run.outcome, run.stopped ? "signal" : "end of bag", counters_json(run.stats, run.violations));
     return run.outcome.exit_code();
-#else
-    (void)properties;
-    (void)opath;
-    std::fprintf(stderr, "rvc: '%s' is an MCAP bag, and this rvc was built without MCAP (RVC_WITH_ZENOH=OFF)\n",
-                 path.c_str());
-    return kUsage;
-#endif
   }
 
   // The run's counters for the results store.
@@ -180,9 +170,10 @@ struct CheckCommand {
 
 Runner register_check(CLI::App& app) {
   auto cmd = std::make_shared<CheckCommand>();
-  CLI::App* sub = app.add_subcommand("check", "Check properties over a JSON-lines trace (file or - for stdin) or a ROS 2 bag (MCAP)");
+  CLI::App* sub = app.add_subcommand("check", "Check properties over a JSON-lines trace (file or - for stdin) or a ROS 2 bag (MCAP, sqlite3, bag folder)");
   cmd->check.add_to(*sub);
-  sub->add_option("trace", cmd->input, "Trace: PATH, file:PATH or - for stdin (JSON lines), or a ROS 2 bag (MCAP)")
+  sub->add_option("trace", cmd->input, "Trace: PATH, file:PATH or - for stdin (JSON lines), or a ROS 2 bag: a .mcap or .db3 file or a bag folder "
+                  "(found by content; bag:PATH says so)")
       ->required();
   sub->add_option("--topic", cmd->topics,
                   "The topic of a bag to check (needed when the bag holds several); repeatable: NAME=TOPIC (or TOPIC, "

@@ -18,7 +18,9 @@
 #include "io/cdr_codec.hpp"
 #include "cli/type_options.hpp"
 #include "msg/type_registry.hpp"
+#include "runtime/check_bag.hpp"
 #include "transport/frame_queue.hpp"
+#include "transport/rosbag2/bag_reader.hpp"
 #include "transport/transport_options.hpp"
 
 namespace rvc::cli {
@@ -31,6 +33,7 @@ struct EchoCommand {
   uint64_t count = 0;        // 0: no limit
   double idle_timeout = 0;   // 0: none
   std::vector<std::string> fields;  // --field: only these paths of a typed sample
+  std::string topic;                // --topic: of a bag
 
   // --field a.b.c: each part a field of the message the previous one names.
   static bool select(const msg::MessageType& type, const std::string& path, io::CdrSelection& selection) {
@@ -62,7 +65,95 @@ struct EchoCommand {
     return true;
   }
 
+  // The bag a bag:/mcap: URI, a .mcap/.db3 file or a bag folder names; "" for other inputs.
+  std::string bag_path() const {
+    const std::string scheme = transport::scheme_of(input);
+    if (scheme == "mcap") return input.substr(input.find(':') + 1);
+    if (scheme != "file" || input == "-") return "";
+    const std::string path = input.rfind("file:", 0) == 0 ? input.substr(5) : input;
+    return transport::is_bag(path) ? path : "";
+  }
+
+  // Writes one line to stdout; false (after saying so) when stdout fails.
+  static bool put_line(std::string_view line) {
+    if (std::fwrite(line.data(), 1, line.size(), stdout) == line.size() && std::fputc('\n', stdout) != EOF) return true;
+    std::fprintf(stderr, "rvc: cannot write to stdout: %s\n", std::strerror(errno));
+    return false;
+  }
+
+  // A bag's topic, in the bag's order: each message as `rvc echo` prints a
+  // live sample of the type the bag records (same decoder, same JSON).
+  int run_bag(const std::string& path) {
+    if (typed.given()) {
+      std::fprintf(stderr, "rvc: a bag names the type of each topic itself: drop --type\n");
+      return kUsage;
+    }
+    for (const auto& dir : typed.msg_paths) typed.registry.add_search_path(dir);
+    const runtime::BagInput in = runtime::select_bag_topic(path, topic, typed.registry);
+    io::CdrSelection selection;
+    if (!fields.empty() && !in.type) {
+      std::fprintf(stderr, "rvc: --field selects fields of typed samples; topic %s carries JSON\n", in.topic.c_str());
+      return kUsage;
+    }
+    for (const auto& f : fields)
+      if (!select(*in.type, f, selection)) return kUsage;
+    install_stop_signals();
+    auto reader = transport::open_bag(path);
+    uint64_t printed = 0, rejected = 0;
+    reader->on_skip([&](const std::string& why) {
+      if (++rejected <= 100) std::fprintf(stderr, "rvc: bag '%s': %s\n", path.c_str(), why.c_str());
+    });
+    transport::BagMessage m;
+    std::string json;
+    try {
+      while (!stop_requested() && (count == 0 || printed < count) && reader->next(m)) {
+        if (m.topic != in.topic) continue;
+        std::string_view line = m.data;
+        if (in.type) {
+          io::CdrError error;
+          json.clear();
+          if (!io::cdr_to_json(*in.type, m.data, json, error, fields.empty() ? nullptr : &selection)) {
+            if (++rejected <= 100)
+              std::fprintf(stderr, "rvc: message %llu: not a %s: %s (skipped)\n",
+                           static_cast<unsigned long long>(m.index), in.type->full_name().c_str(),
+                           error.to_string().c_str());
+            continue;
+          }
+          line = json;
+        }
+        if (!put_line(line)) return kRuntime;
+        ++printed;
+      }
+    } catch (const transport::BagError& e) {  // cut short: what came before was printed
+      std::fprintf(stderr, "rvc: %s (the messages before it were printed)\n", e.what());
+      ++rejected;
+    }
+    if (std::fflush(stdout) != 0) {
+      std::fprintf(stderr, "rvc: cannot write to stdout: %s\n", std::strerror(errno));
+      return kRuntime;
+    }
+    if (rejected > 0) {
+      if (printed == 0) runtime::hint_bag_definition(in);
+      std::fprintf(stderr, "rvc echo: %llu message%s of the bag could not be read or decoded\n",
+                   static_cast<unsigned long long>(rejected), rejected == 1 ? "" : "s");
+      return kBadInput;
+    }
+    return printed == 0 ? kIncomplete : kOk;
+  }
+
   int run() {
+    if (const std::string bag = bag_path(); !bag.empty()) return run_bag(bag);
+    if (!topic.empty()) {
+      std::fprintf(stderr, "rvc: --topic chooses a topic of a bag (bag:PATH, a .mcap or .db3 file, a bag folder)\n");
+      return kUsage;
+    }
+    if (transport::scheme_of(input) == "file" && input != "-") {  // a file's lines are printed as they are
+      const std::string path = input.rfind("file:", 0) == 0 ? input.substr(5) : input;
+      if (const std::string what = transport::binary_signature(path); !what.empty()) {
+        std::fprintf(stderr, "rvc: input '%s' is %s, not JSON lines\n", path.c_str(), what.c_str());
+        return kUsage;
+      }
+    }
     if (typed.given() && !TypeOptions::typed_scheme(input)) {
       std::fprintf(stderr, "rvc: --type reads dds: or zenoh: inputs; for CDR in a file use `rvc msg decode`\n");
       return kUsage;
@@ -144,16 +235,17 @@ struct EchoCommand {
 
 Runner register_echo(CLI::App& app) {
   auto cmd = std::make_shared<EchoCommand>();
-  CLI::App* sub = app.add_subcommand("echo", "Print the messages of an endpoint as JSON lines (typed ROS 2 topics with --type)");
-  sub->add_option("input", cmd->input, "Endpoint: dds:TOPIC, zenoh:KEYEXPR, file:PATH")->required();
+  CLI::App* sub = app.add_subcommand("echo", "Print the messages of an endpoint or a ROS 2 bag's topic as JSON lines (typed ROS 2 topics with --type)");
+  sub->add_option("input", cmd->input, "Endpoint: dds:TOPIC, zenoh:KEYEXPR, file:PATH, or a ROS 2 bag (bag:PATH, a .mcap or .db3 file, a bag folder)")->required();
   cmd->typed.add_to(*sub, "Message type of the samples: ROS 2 pkg/msg/Name (`rvc msg list`) or a DDS IDL name from --msg-path");
   sub->add_option("--field", cmd->fields,
                   "Print only this field of each typed sample, e.g. status.twist (repeatable; the rest is still "
                   "checked)");
+  sub->add_option("--topic", cmd->topic, "The topic of a bag to print (needed when the bag holds several)");
   sub->add_option("--count,-n", cmd->count, "Stop after this many messages (default: no limit)");
   sub->add_option("--idle-timeout", cmd->idle_timeout, "Stop after this many seconds without a message")
       ->check(CLI::NonNegativeNumber);
-  sub->footer("Exit status: 0 messages printed, 3 samples could not be decoded, 5 stdout could not be written, "
+  sub->footer("Exit status: 0 messages printed, 3 samples could not be decoded (or records of a bag were damaged), 5 stdout could not be written, "
               "6 nothing arrived.");
   add_transport_options(*sub, cmd->transports);
   return [cmd] { return cmd->run(); };

@@ -26,9 +26,8 @@
 #include "runtime/message_filter.hpp"
 #include "runtime/monitor_loop.hpp"
 #include "runtime/synced_pipeline.hpp"
-#ifdef RVC_HAVE_MCAP
 #include "cli/bag_run.hpp"
-#endif
+#include "transport/rosbag2/bag_reader.hpp"
 #include "transport/transport_options.hpp"
 
 namespace rvc::cli {
@@ -197,16 +196,37 @@ struct MonitorCommand {
     return finish_enforcer(outcome.exit_code());
   }
 
+  // A path of a file: input (a plain path, file:PATH), "" for anything else.
+  static std::string file_path(const std::string& uri) {
+    if (transport::scheme_of(uri) != "file" || uri == "-") return "";
+    return uri.rfind("file:", 0) == 0 ? uri.substr(5) : uri;
+  }
+  // bag:PATH, mcap:PATH, or a file or folder that is a bag by its content.
+  static bool is_bag_input(const std::string& uri) {
+    if (transport::scheme_of(uri) == "mcap") return true;
+    const std::string path = file_path(uri);
+    return !path.empty() && transport::is_bag(path);
+  }
+  // A binary file where JSON lines are expected: one clear line, not an error per line.
+  static bool refuse_binary_file(const std::string& uri) {
+    const std::string path = file_path(uri);
+    if (path.empty()) return false;
+    const std::string what = transport::binary_signature(path);
+    if (what.empty()) return false;
+    std::fprintf(stderr, "rvc: input '%s' is %s, not JSON lines\n", path.c_str(), what.c_str());
+    return true;
+  }
+
   // A ROS 2 bag: played through the runtime at once, its topic's type from
   // the bag's own schema (as `rvc check bag.mcap`).
   int run_bag(const std::vector<engine::PropertySpec>& properties, runtime::PipelineOptions popts,
               runtime::VerdictOutputs& verdicts) {
-#ifdef RVC_HAVE_MCAP
     if (typed.given()) {
       std::fprintf(stderr, "rvc: a bag names the type of each topic itself: drop --type\n");
       return kUsage;
     }
-    const std::string path = input.substr(5);
+    const std::string path =
+        transport::scheme_of(input) == "mcap" ? input.substr(input.find(':') + 1) : file_path(input);
     std::fprintf(stderr, "rvc monitor: %zu propert%s on %s -> %zu output%s\n", properties.size(),
                  properties.size() == 1 ? "y" : "ies", input.c_str(), verdicts.size(), verdicts.size() == 1 ? "" : "s");
     attach_results(input, popts, verdicts);
@@ -221,13 +241,6 @@ struct MonitorCommand {
     std::fprintf(stderr, "%s\n", stats.c_str());
     if (results) results->finish(run.outcome, run.stopped ? "signal" : "end of bag", stats);
     return finish_enforcer(run.outcome.exit_code());
-#else
-    (void)properties;
-    (void)popts;
-    (void)verdicts;
-    std::fprintf(stderr, "rvc: this rvc was built without MCAP bags (RVC_WITH_ZENOH=OFF)\n");
-    return kUsage;
-#endif
   }
 
   // An output that the input would read back (the same file, an
@@ -287,7 +300,7 @@ struct MonitorCommand {
   int run_synced() {
     auto properties = check.properties();
     if (!topics.empty()) {
-      std::fprintf(stderr, "rvc: --topic chooses a topic of a bag (--input mcap:PATH)\n");
+      std::fprintf(stderr, "rvc: --topic chooses a topic of a bag (--input bag:PATH)\n");
       return kUsage;
     }
     std::vector<transport::TransportOptions> per_input;
@@ -379,7 +392,8 @@ struct MonitorCommand {
     if (!store.take_database(outputs)) return kUsage;
     if (outputs.empty()) outputs.push_back("-");
     if (SyncFlags::named(inputs)) return run_synced();
-    const bool bag = transport::scheme_of(inputs.at(0)) == "mcap";
+    const bool bag = is_bag_input(inputs.at(0));
+    if (!bag && refuse_binary_file(inputs.at(0))) return kUsage;
     if (!bag && (!sync.stamps.empty() || app->count("--sync") || app->count("--pivot") || app->count("--lower-bound"))) {
       std::fprintf(stderr, "rvc: --stamp, --sync, --pivot and --lower-bound synchronize several inputs: give them as "
                            "--input NAME=URI (or several --topic of a bag)\n");
@@ -387,7 +401,7 @@ struct MonitorCommand {
     }
     input = inputs.at(0);
     if (bag && !health.uris.empty()) {
-      std::fprintf(stderr, "rvc: --diagnostics reports a live monitor's health; a bag (mcap:) is checked at once: "
+      std::fprintf(stderr, "rvc: --diagnostics reports a live monitor's health; a bag (bag:) is checked at once: "
                            "drop --diagnostics\n");
       return kUsage;
     }
@@ -402,9 +416,9 @@ struct MonitorCommand {
       if (int status = open_health(properties, verdicts, {input})) return status;
     runtime::PipelineOptions popts = check.pipeline_options();
     popts.position_name = "seq";
-    if (transport::scheme_of(input) == "mcap") return run_bag(properties, popts, verdicts);
+    if (bag) return run_bag(properties, popts, verdicts);
     if (!topics.empty()) {
-      std::fprintf(stderr, "rvc: --topic chooses a topic of a bag (--input mcap:PATH)\n");
+      std::fprintf(stderr, "rvc: --topic chooses a topic of a bag (--input bag:PATH)\n");
       return kUsage;
     }
     transport::TransportOptions input_transports = transports;  // outputs stay std_msgs/String
@@ -465,7 +479,7 @@ Runner register_monitor(CLI::App& app) {
   cmd->app = sub;
   cmd->input_option =
       sub->add_option("--input,-i", cmd->inputs,
-                      "Endpoint to monitor: zenoh:KEYEXPR, dds:TOPIC, file:PATH, - or mcap:BAG (a ROS 2 bag); "
+                      "Endpoint to monitor: zenoh:KEYEXPR, dds:TOPIC, file:PATH, - or bag:BAG (a ROS 2 bag: .mcap, .db3 or a bag folder; mcap:BAG too); "
                       "several as NAME=URI (repeatable), synchronized by --sync, tested as {NAME.field}")
           ->required();
   sub->add_option("--output,-o", cmd->outputs,
@@ -527,10 +541,10 @@ Runner register_monitor(CLI::App& app) {
                     "several inputs: after the --input it is for, or NAME=pkg/msg/Name");
   sub->get_option("--msg-path")
       ->description("Folder of .msg/.idl definitions (a ROS 2 share/ tree or a plain folder), or one .idl file "
-                    "(repeatable): for --type, and for --input mcap:BAG the types its schemas name but do not define");
+                    "(repeatable): for --type, and for --input bag:BAG the types its schemas name but do not define");
   cmd->sync.add_to(*sub);
   sub->add_option("--topic", cmd->topics,
-                  "With --input mcap:BAG: the topic to check (if the bag holds several); repeatable: NAME=TOPIC, "
+                  "With --input bag:BAG: the topic to check (if the bag holds several); repeatable: NAME=TOPIC, "
                   "synchronized by --sync");
   cmd->clock.add_live(*sub);
   sub->add_option("--queue", cmd->queue_capacity, "Messages buffered between transport and engine")

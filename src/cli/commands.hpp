@@ -30,5 +30,6 @@ Runner register_echo(CLI::App& app);        // print an endpoint's messages as J
 Runner register_hz(CLI::App& app);          // rate/jitter/silence/latency health check, /diagnostics
 Runner register_sync(CLI::App& app);        // several topics -> one stream of sets
 Runner register_dashboard(CLI::App& app);   // web page over a results database
+Runner register_bag(CLI::App& app);         // rvc bag info: what a ROS 2 bag holds
 
 }  // namespace rvc::cli

@@ -51,6 +51,7 @@ int main(int argc, char** argv) {
       {"msg", register_msg},       {"echo", register_echo},             {"sync", register_sync},
       {"hz", register_hz},         {"calls", register_calls},
       {"dashboard", register_dashboard},
+      {"bag", register_bag},
 #ifdef RVC_HAVE_ZENOH
       {"router", register_router},
 #endif

@@ -44,6 +44,9 @@ class TypeRegistry {
   // of the search folders). Throws MsgError.
   const MessageType& resolve(std::string_view type_name);
 
+  // The folders (or .idl files) given with add_search_path, in order.
+  const std::vector<std::string>& search_paths() const { return search_paths_; }
+
   // Names of the bundled types ("pkg/msg/Name"), sorted.
   static std::vector<std::string> bundled_types();
 

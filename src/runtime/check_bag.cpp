@@ -8,78 +8,120 @@
 #include <stdexcept>
 
 #include "runtime/check_stream.hpp"
-#include "transport/mcap/mcap_bag.hpp"
+#include <filesystem>
+
+#include "transport/rosbag2/bag_reader.hpp"
 
 namespace rvc::runtime {
 
 namespace {
 
-std::string describe(const std::map<std::string, transport::BagTopic>& topics) {
+std::string describe(const std::vector<transport::BagTopicInfo>& topics) {
   std::string s;
-  for (const auto& [name, t] : topics) {
-    s += "\n  " + name + " (" + (t.schema_name.empty() ? t.message_encoding : t.schema_name) + ", " +
-         std::to_string(t.messages) + " message" + (t.messages == 1 ? "" : "s") + ")";
+  for (const auto& t : topics) {
+    if (t.messages == 0) continue;
+    s += "\n  " + t.name + " (" + (t.type.empty() ? t.encoding : t.type) + ", " + std::to_string(t.messages) +
+         " message" + (t.messages == 1 ? "" : "s") + ")";
   }
   return s;
+}
+
+// Whether a --msg-path folder holds the type's own definition: then it is
+// taken from there, not from the bag (a user's definition corrects a bag
+// whose recorded one is wrong or cut short, as some rosbag2 test bags are).
+bool in_search_paths(const msg::TypeRegistry& registry, const std::string& type) {
+  const size_t a = type.find('/'), b = type.rfind('/');
+  if (a == std::string::npos) return false;
+  const std::string pkg = type.substr(0, a), kind = a == b ? "msg" : type.substr(a + 1, b - a - 1),
+                    name = type.substr(b + 1);
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  for (const auto& dir : registry.search_paths())
+    for (const char* ext : {".msg", ".idl"})
+      for (const fs::path& p : {fs::path(dir) / pkg / kind / (name + ext), fs::path(dir) / "share" / pkg / kind / (name + ext),
+                                fs::path(dir) / (name + ext)})
+        if (fs::is_regular_file(p, ec)) return true;
+  return false;
 }
 
 }  // namespace
 
 BagInput select_bag_topic(const std::string& path, const std::string& topic, msg::TypeRegistry& registry) {
-  const transport::BagContents contents = transport::bag_topics(path);
-  const auto& topics = contents.topics;
-  if (topics.empty())
+  const transport::BagSummary contents = transport::summarize_bag(path);
+  size_t with_messages = 0;
+  const transport::BagTopicInfo* only = nullptr;
+  for (const auto& t : contents.topics)
+    if (t.messages) {
+      ++with_messages;
+      only = &t;
+    }
+  if (with_messages == 0)
     throw std::invalid_argument(!contents.broken.empty()          ? contents.broken
                                 : !contents.first_skipped.empty() ? contents.first_skipped
                                                                   : "bag '" + path + "' holds no messages");
   BagInput in;
   in.path = path;
   if (topic.empty()) {
-    if (topics.size() > 1)
-      throw std::invalid_argument("bag '" + path + "' holds " + std::to_string(topics.size()) +
-                                  " topics: choose one with --topic" + describe(topics));
-    in.topic = topics.begin()->first;
+    if (with_messages > 1)
+      throw std::invalid_argument("bag '" + path + "' holds " + std::to_string(with_messages) +
+                                  " topics: choose one with --topic" + describe(contents.topics));
+    in.topic = only->name;
   } else {
-    if (!topics.count(topic))
-      throw std::invalid_argument("bag '" + path + "' has no topic '" + topic + "'; its topics:" + describe(topics));
+    const transport::BagTopicInfo* t = contents.topic(topic);
+    if (!t || t->messages == 0)
+      throw std::invalid_argument("bag '" + path + "' has no " + (t ? "message on topic '" : "topic '") + topic +
+                                  "'; its topics:" + describe(contents.topics));
     in.topic = topic;
   }
-  const transport::BagTopic& t = topics.at(in.topic);
+  const transport::BagTopicInfo& t = *contents.topic(in.topic);
   in.messages = t.messages;
-  if (t.message_encoding == "json") return in;  // JSON messages: the usual path
-  if (t.message_encoding != "cdr")
-    throw std::invalid_argument("topic '" + in.topic + "' of bag '" + path + "' is encoded as '" +
-                                t.message_encoding + "': rvc reads ROS 2 CDR and JSON messages");
-  if (t.schema_name.empty())
+  if (t.encoding == "json") return in;  // JSON messages: the usual path
+  if (t.encoding != "cdr")
+    throw std::invalid_argument("topic '" + in.topic + "' of bag '" + path + "' is encoded as '" + t.encoding +
+                                "': rvc reads ROS 2 CDR and JSON messages");
+  if (t.type.empty())
     throw std::invalid_argument("topic '" + in.topic + "' of bag '" + path +
-                                "' has no schema: the bag does not say which type its CDR messages are");
-  // A schema may name the type and hold no definition (some writers record
-  // only the name): then the type comes from --msg-path or the bundled
-  // definitions, as does any type a schema uses but leaves out.
-  const bool defined = t.schema.find_first_not_of(" \t\r\n") != std::string::npos;
-  if (t.schema_encoding == "ros2msg") {
-    if (defined) registry.add_concatenated(t.schema_name, t.schema, "schema of " + in.topic + " in " + path);
-  } else if (t.schema_encoding == "ros2idl") {  // types defined in .idl only (rosbag2 records them so)
-    if (defined) registry.add_concatenated_idl(t.schema, "schema of " + in.topic + " in " + path);
-  } else {
-    throw std::invalid_argument("topic '" + in.topic + "' of bag '" + path + "' has a '" + t.schema_encoding +
-                                "' schema: rvc reads ROS 2 schemas (ros2msg, ros2idl)");
+                                "' has no schema (no type): the bag does not say which type its CDR messages are");
+  // A bag may name the type and hold no definition (sqlite3 bags before
+  // Iron, some writers): then the type comes from --msg-path or the bundled
+  // definitions, as does any type a definition uses but leaves out. A type
+  // that --msg-path defines is taken from there.
+  const bool defined = t.definition.find_first_not_of(" \t\r\n") != std::string::npos;
+  const std::string source = "definition of " + in.topic + " in " + path;
+  if (defined && !in_search_paths(registry, t.type)) {
+    in.bag_definition = t.definition_encoding == "ros2msg" || t.definition_encoding == "ros2idl";
+    if (t.definition_encoding == "ros2msg")
+      registry.add_concatenated(t.type, t.definition, source);
+    else if (t.definition_encoding == "ros2idl")  // types defined in .idl only (rosbag2 records them so)
+      registry.add_concatenated_idl(t.definition, source);
+    else if (!t.definition_encoding.empty())
+      throw std::invalid_argument("topic '" + in.topic + "' of bag '" + path + "' has a '" + t.definition_encoding +
+                                  "' definition: rvc reads ROS 2 definitions (ros2msg, ros2idl)");
   }
-  in.type = &registry.resolve(t.schema_name);
+  in.type = &registry.resolve(t.type);
   return in;
+}
+
+void hint_bag_definition(const BagInput& in) {
+  if (!in.bag_definition || !in.type) return;
+  std::fprintf(stderr,
+               "rvc: no message of %s decoded with the definition of %s that bag '%s' records: if that definition is "
+               "wrong or cut short, give the type's .msg with --msg-path DIR (docs/bags.md)\n",
+               in.topic.c_str(), in.type->full_name().c_str(), in.path.c_str());
 }
 
 Outcome check_bag(const std::vector<BagInput>& inputs, Feed& feed, VerdictOutputs& outputs, uint64_t& skipped,
                   const std::function<bool()>& stop, bool tick_at_end) {
   skipped = 0;
   return run_check(feed, outputs, [&](Outcome& outcome) {
-    transport::McapBag bag(inputs.at(0).path);
+    std::unique_ptr<transport::BagReader> reader = transport::open_bag(inputs.at(0).path);
+    transport::BagReader& bag = *reader;
     constexpr uint64_t kShown = 100;  // as the pipeline's errors: a bag of bad records does not flood stderr
     bag.on_skip([&](const std::string& reason) {
       if (skipped++ < kShown) std::fprintf(stderr, "rvc: bag '%s': %s\n", bag.path().c_str(), reason.c_str());
       outcome.rejected = true;
     });
-    transport::McapMessage m;
+    transport::BagMessage m;
     double end_log = 0;  // the latest log time of any message: where the recording ends
     double last_stamp = std::numeric_limits<double>::quiet_NaN(), stamp_log = 0;
     for (uint64_t n = 0;; ++n) {
@@ -92,7 +134,7 @@ Outcome check_bag(const std::vector<BagInput>& inputs, Feed& feed, VerdictOutput
       }
       try {
         if (!bag.next(m)) break;
-      } catch (const transport::McapError& e) {
+      } catch (const transport::BagError& e) {
         // A recording cut short: what came before the break was checked and
         // stands; the rest of the bag is bad input, not a failure of rvc.
         std::fprintf(stderr, "rvc: %s (the messages before it were checked)\n", e.what());
@@ -140,7 +182,7 @@ std::vector<SyncInput> select_bag_topics(const std::string& path, const std::vec
       in.name = topic.substr(topic.find_last_of('/') + 1);
     }
     bags.push_back(select_bag_topic(path, topic, registry));
-    in.uri = "mcap:" + path + " " + topic;
+    in.uri = "bag:" + path + " " + topic;
     in.type = bags.back().type;
     inputs.push_back(std::move(in));
   }

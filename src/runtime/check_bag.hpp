@@ -21,7 +21,13 @@ struct BagInput {
   std::string topic;                     // the topic checked
   const msg::MessageType* type = nullptr;  // CDR samples of this type; null: JSON messages
   uint64_t messages = 0;                 // of that topic
+  bool bag_definition = false;           // its definition came from the bag (not --msg-path or bundled)
 };
+
+// When no sample of a topic decoded and its definition came from the bag:
+// the hint that the recorded definition may be wrong (some rosbag2 bags
+// record stand-ins), printed once on stderr.
+void hint_bag_definition(const BagInput& in);
 
 // Picks the topic to check: `topic` if given (it must be in the bag), else
 // the bag's only topic. Registers its schema in `registry` and resolves the

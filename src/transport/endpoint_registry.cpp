@@ -25,6 +25,9 @@ Parsed parse(const std::string& uri) {
   auto colon = uri.find(':');
   if (colon == std::string::npos) return {"file", uri};  // a plain path
   std::string scheme = uri.substr(0, colon), rest = uri.substr(colon + 1);
+  // bag:PATH and mcap:PATH both name a ROS 2 bag of any storage (MCAP,
+  // sqlite3, a bag folder: transport/rosbag2), told apart by content.
+  if (scheme == "bag") scheme = "mcap";
   if (scheme == "file" || scheme == "zenoh" || scheme == "dds" || scheme == "mcap") {
     if (rest.empty()) throw std::invalid_argument("endpoint '" + uri + "' names no " +
                                                   (scheme == "file" || scheme == "mcap" ? "path"
@@ -34,7 +37,7 @@ Parsed parse(const std::string& uri) {
   }
   if (scheme.size() == 1) return {"file", uri};  // not a scheme: a Windows-like path "C:..."
   throw std::invalid_argument("unknown endpoint scheme '" + scheme + ":' in '" + uri +
-                              "' (use file:PATH, -, zenoh:KEYEXPR, dds:TOPIC or, as an input, mcap:BAG)");
+                              "' (use file:PATH, -, zenoh:KEYEXPR, dds:TOPIC or, as an input, bag:BAG)");
 }
 
 [[noreturn, maybe_unused]] void not_built(const std::string& scheme) {
@@ -102,7 +105,7 @@ std::unique_ptr<Source> open_source(const std::string& uri, const TransportOptio
 
 std::unique_ptr<Sink> open_sink(const std::string& uri, const TransportOptions& options) {
   Parsed p = parse(uri);
-  if (p.scheme == "mcap") throw std::invalid_argument("'" + uri + "': rvc reads bags (mcap:), it does not write them");
+  if (p.scheme == "mcap") throw std::invalid_argument("'" + uri + "': rvc reads bags (bag:, mcap:), it does not write them");
   if (p.scheme == "file") return std::make_unique<FileSink>(p.rest);
   if (p.scheme == "zenoh") {
 #ifdef RVC_HAVE_ZENOH

@@ -1,0 +1,92 @@
+#include "transport/rosbag2/zstd_bag.hpp"
+
+#include <unistd.h>
+#include <zstd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <memory>
+#include <vector>
+
+#include "transport/rosbag2/bag_reader.hpp"
+
+namespace rvc::transport {
+
+bool is_zstd_frame(std::string_view b) {
+  return b.size() >= 4 && static_cast<unsigned char>(b[0]) == 0x28 && static_cast<unsigned char>(b[1]) == 0xB5 &&
+         static_cast<unsigned char>(b[2]) == 0x2F && static_cast<unsigned char>(b[3]) == 0xFD;
+}
+
+namespace {
+struct DStream {
+  ZSTD_DStream* s = ZSTD_createDStream();
+  ~DStream() { ZSTD_freeDStream(s); }
+};
+}  // namespace
+
+bool zstd_decompress(std::string_view in, std::string& out, std::string& error) {
+  out.clear();
+  DStream d;
+  ZSTD_inBuffer src{in.data(), in.size(), 0};
+  std::vector<char> buf(ZSTD_DStreamOutSize());
+  size_t ret = 0;
+  for (;;) {
+    ZSTD_outBuffer dst{buf.data(), buf.size(), 0};
+    ret = ZSTD_decompressStream(d.s, &dst, &src);
+    if (ZSTD_isError(ret)) {
+      error = std::string("zstd: ") + ZSTD_getErrorName(ret) + " near byte " + std::to_string(src.pos);
+      return false;
+    }
+    out.append(buf.data(), dst.pos);
+    if (src.pos == src.size && dst.pos < dst.size) break;  // all input read, nothing more held back
+  }
+  if (ret != 0) {
+    error = "zstd: the compressed data is cut short after " + std::to_string(in.size()) + " bytes";
+    return false;
+  }
+  return true;
+}
+
+ZstdFileCopy::ZstdFileCopy(const std::string& compressed) {
+  std::ifstream in(compressed, std::ios::binary);
+  if (!in) throw BagError("bag '" + compressed + "': cannot open it");
+  const char* tmp = std::getenv("TMPDIR");
+  std::string templ = std::string(tmp && *tmp ? tmp : "/tmp") + "/rvc-bag-XXXXXX";
+  const int fd = ::mkstemp(templ.data());
+  if (fd < 0) throw BagError("bag '" + compressed + "': cannot create a temporary file to decompress it into");
+  path_ = templ;
+  std::unique_ptr<FILE, int (*)(FILE*)> out(::fdopen(fd, "wb"), &std::fclose);
+  DStream d;
+  std::vector<char> ibuf(ZSTD_DStreamInSize()), obuf(ZSTD_DStreamOutSize());
+  uint64_t offset = 0;
+  size_t ret = 0;
+  auto fail = [&](const std::string& why) {
+    ::unlink(path_.c_str());
+    throw BagError("bag '" + compressed + "': " + why);
+  };
+  while (in) {
+    in.read(ibuf.data(), static_cast<std::streamsize>(ibuf.size()));
+    ZSTD_inBuffer src{ibuf.data(), static_cast<size_t>(in.gcount()), 0};
+    for (;;) {
+      ZSTD_outBuffer dst{obuf.data(), obuf.size(), 0};
+      ret = ZSTD_decompressStream(d.s, &dst, &src);
+      if (ZSTD_isError(ret))
+        fail(std::string("not a whole zstd file: ") + ZSTD_getErrorName(ret) + " near byte " +
+             std::to_string(offset + src.pos));
+      if (dst.pos && std::fwrite(obuf.data(), 1, dst.pos, out.get()) != dst.pos)
+        fail("cannot write the decompressed copy to " + path_);
+      if (src.pos == src.size && dst.pos < dst.size) break;
+    }
+    offset += src.size;
+  }
+  if (ret != 0) fail("the zstd data is cut short after " + std::to_string(offset) + " bytes");
+  if (std::fflush(out.get()) != 0) fail("cannot write the decompressed copy to " + path_);
+}
+
+ZstdFileCopy::~ZstdFileCopy() {
+  if (!path_.empty()) ::unlink(path_.c_str());
+}
+
+}  // namespace rvc::transport

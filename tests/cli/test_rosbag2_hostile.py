@@ -1,0 +1,190 @@
+"""Hostile rosbag2 sqlite3 bags: not a bag, tables or columns missing, values of the wrong SQLite
+type, a topic id that names no topic, a CDR blob cut short, a database cut in half, a broken
+metadata.yaml. Each gives one clear line naming the problem (and the message, by index and row id),
+the exit status of docs/cli.md, never a crash; the valid messages around a bad row are still
+checked, with verdicts equal to `rvc check` on the same valid values as JSON lines.
+
+Bags are written here with Python's sqlite3 in rosbag2's schema, samples serialized by rosbags.
+"""
+import json
+import os
+import sqlite3
+import subprocess
+
+import pytest
+
+SCHEMA = """
+CREATE TABLE schema(schema_version INTEGER PRIMARY KEY, ros_distro TEXT NOT NULL);
+CREATE TABLE metadata(id INTEGER PRIMARY KEY, metadata_version INTEGER NOT NULL, metadata TEXT NOT NULL);
+CREATE TABLE topics(id INTEGER PRIMARY KEY, name TEXT NOT NULL, type TEXT NOT NULL,
+                    serialization_format TEXT NOT NULL, offered_qos_profiles TEXT NOT NULL,
+                    type_description_hash TEXT NOT NULL);
+CREATE TABLE message_definitions(id INTEGER PRIMARY KEY, topic_type TEXT NOT NULL, encoding TEXT NOT NULL,
+                                 encoded_message_definition TEXT NOT NULL, type_description_hash TEXT NOT NULL);
+CREATE TABLE messages(id INTEGER PRIMARY KEY, topic_id INTEGER NOT NULL, timestamp INTEGER NOT NULL, data BLOB NOT NULL);
+"""
+SPEC = "historically({data < 30})"
+
+
+def run(args, **kw):
+    # errors="replace": a damaged bag's names may hold any bytes, and rvc prints them as the bag has them
+    return subprocess.run(args, capture_output=True, text=True, errors="replace", timeout=120, **kw)
+
+
+def float64(v):
+    """std_msgs/msg/Float64 as CDR, serialized by rosbags."""
+    from rosbags.typesys import Stores, get_typestore
+    ts = get_typestore(Stores.ROS2_HUMBLE)
+    t = ts.types["std_msgs/msg/Float64"]
+    return bytes(ts.serialize_cdr(t(data=v), t.__msgtype__))
+
+
+def make_db3(path, rows, schema=SCHEMA, definitions=True):
+    con = sqlite3.connect(path)
+    con.executescript(schema)
+    if "CREATE TABLE topics" in schema:
+        con.execute("INSERT INTO topics VALUES (1, '/speed', 'std_msgs/msg/Float64', 'cdr', '', '')")
+    if definitions and "message_definitions" in schema:
+        con.execute("INSERT INTO message_definitions VALUES (1, 'std_msgs/msg/Float64', 'ros2msg', 'float64 data', '')")
+    for row in rows:
+        con.execute("INSERT INTO messages(topic_id, timestamp, data) VALUES (?, ?, ?)", row)
+    con.commit()
+    con.close()
+    return str(path)
+
+
+def good_rows(values):
+    return [(1, 1000 + i, float64(v)) for i, v in enumerate(values)]
+
+
+def check(rvc, bag, *extra):
+    return run([rvc, "check", bag, "--spec", SPEC, "--stats", *extra])
+
+
+def test_valid_db3_checks_like_json(rvc, tmp_path):
+    values = [1.0, 2.0, 31.0, 4.0]
+    bag = make_db3(tmp_path / "ok.db3", good_rows(values))
+    trace = tmp_path / "t.jsonl"
+    trace.write_text("".join(json.dumps({"time": i, "data": v}) + "\n" for i, v in enumerate(values)))
+    r, want = check(rvc, bag), run([rvc, "check", "--spec", SPEC, str(trace)])
+    assert r.returncode == want.returncode == 1, r.stderr
+    assert [json.loads(x)["value"] for x in r.stdout.splitlines()] == [json.loads(x)["value"] for x in want.stdout.splitlines()]
+
+
+@pytest.mark.parametrize("what,schema,needle", [
+    ("no tables", "CREATE TABLE notes(id INTEGER, text TEXT);", "not a rosbag2 bag: it has no table 'topics'"),
+    ("no messages", SCHEMA.split("CREATE TABLE messages")[0], "not a rosbag2 bag: it has no table 'messages'"),
+    ("no data column", SCHEMA.replace(", data BLOB NOT NULL", ""), "table 'messages' has no column 'data'"),
+])
+def test_sqlite_that_is_no_bag_is_refused(rvc, tmp_path, what, schema, needle):
+    con = sqlite3.connect(tmp_path / "x.db3")
+    con.executescript(schema)
+    con.commit()
+    con.close()
+    bag = str(tmp_path / "x.db3")
+    for args in (["check", bag, "--spec", SPEC], ["echo", bag], ["bag", "info", bag],
+                 ["monitor", "--input", "bag:" + bag, "--spec", SPEC]):
+        r = run([rvc, *args])
+        assert r.returncode == 2, (what, args, r.stderr)
+        assert needle in r.stderr and "invalid JSON" not in r.stderr, (what, args, r.stderr)
+        assert len(r.stderr.strip().splitlines()) <= 2, r.stderr  # monitor may print its header line first
+
+
+@pytest.mark.parametrize("bad_row,reason", [
+    ((1, 1002, 7), "data is an integer, not a blob"),
+    ((1, "soon", float64(5.0)), "timestamp is text, not nanoseconds since the epoch"),
+    ((9, 1002, float64(5.0)), "topic_id 9 is no row of table 'topics'"),
+])
+def test_rows_of_the_wrong_type_are_skipped_and_counted(rvc, tmp_path, bad_row, reason):
+    values = [1.0, 2.0, 31.0, 4.0]
+    rows = good_rows(values)
+    rows.insert(2, bad_row)
+    bag = make_db3(tmp_path / "bad.db3", rows)
+    r = check(rvc, bag)
+    assert r.returncode == 1, r.stderr  # the violation among the valid rows still counts first
+    assert reason in r.stderr and "(row id 3 of table 'messages')" in r.stderr, r.stderr
+    counters = json.loads(r.stderr.strip().splitlines()[-1])
+    assert counters["checked"] == len(values) and counters["rejected"] == 1
+    assert counters["received"] == counters["checked"] + counters["rejected"]  # the bad row was received too
+    ok = run([rvc, "check", bag, "--spec", "historically({data < 100})", "--stats"])
+    assert ok.returncode == 3, ok.stderr  # nothing violated: the skipped row is rejected input
+    e = run([rvc, "echo", bag])
+    assert e.returncode == 3 and len(e.stdout.splitlines()) == len(values), e.stderr
+
+
+def test_blob_cut_short_is_rejected_with_its_position(rvc, tmp_path):
+    rows = good_rows([1.0, 2.0, 3.0])
+    rows[1] = (1, 1001, float64(2.0)[:10])
+    bag = make_db3(tmp_path / "cut.db3", rows)
+    r = check(rvc, bag)
+    assert r.returncode == 3, r.stderr
+    assert "message 2" in r.stderr, r.stderr
+    counters = json.loads(r.stderr.strip().splitlines()[-1])
+    assert counters["received"] == 3 and counters["checked"] == 2 and counters["rejected"] == 1
+    e = run([rvc, "echo", bag])
+    assert e.returncode == 3 and len(e.stdout.splitlines()) == 2 and "message 2: not a std_msgs/msg/Float64" in e.stderr
+
+
+def test_database_cut_in_half_is_no_crash(rvc, tmp_path):
+    bag = make_db3(tmp_path / "big.db3", good_rows([float(i % 20) for i in range(3000)]))
+    data = open(bag, "rb").read()
+    half = tmp_path / "half.db3"
+    half.write_bytes(data[: len(data) // 2])
+    for args in (["check", str(half), "--spec", SPEC, "--stats"], ["echo", str(half)], ["bag", "info", str(half)]):
+        r = run([rvc, *args])
+        assert r.returncode in (2, 3), (args, r.returncode, r.stderr)  # refused, or read as far as it goes
+        assert r.stderr.strip() and "Traceback" not in r.stderr and len(r.stderr.splitlines()) < 10, r.stderr
+
+
+def test_garbage_after_sqlite_magic(rvc, tmp_path):
+    bad = tmp_path / "fake.db3"
+    bad.write_bytes(b"SQLite format 3\x00" + os.urandom(64))
+    r = run([rvc, "check", str(bad), "--spec", SPEC])
+    assert r.returncode == 2 and "bag '" in r.stderr and len(r.stderr.splitlines()) == 1, r.stderr
+
+
+def test_broken_metadata_yaml_names_its_line(rvc, tmp_path):
+    folder = tmp_path / "bag"
+    folder.mkdir()
+    make_db3(folder / "bag_0.db3", good_rows([1.0]))
+    (folder / "metadata.yaml").write_text("rosbag2_bagfile_information:\n  version: 8\n  files: [\n")
+    r = run([rvc, "check", str(folder), "--spec", SPEC])
+    assert r.returncode == 2 and "metadata.yaml:" in r.stderr and len(r.stderr.splitlines()) == 1, r.stderr
+    (folder / "metadata.yaml").write_text("rosbag2_bagfile_information:\n  relative_file_paths: [gone.db3]\n")
+    r = run([rvc, "echo", str(folder)])
+    assert r.returncode == 2 and "'gone.db3', which is not in the folder" in r.stderr, r.stderr
+
+
+def test_db3_without_definitions_uses_bundled_types(rvc, tmp_path):
+    """A Humble bag (no message_definitions table): std_msgs/Float64 from the bundled definitions."""
+    schema = SCHEMA.replace(SCHEMA[SCHEMA.index("CREATE TABLE message_definitions"):SCHEMA.index("CREATE TABLE messages")], "")
+    bag = make_db3(tmp_path / "humble.db3", good_rows([1.0, 2.0]), schema=schema)
+    r = run([rvc, "echo", bag])
+    assert r.returncode == 0, r.stderr
+    assert [json.loads(x) for x in r.stdout.splitlines()] == [{"data": 1.0}, {"data": 2.0}]
+
+
+def test_corrupted_db3_never_crashes(rvc, tmp_path):
+    """Seeded random damage (bytes overwritten, the file cut) to a valid db3 bag, 150 variants:
+    every run ends with an exit status of docs/cli.md, never a signal, and says why on stderr."""
+    import random
+    rng = random.Random(28)
+    good = open(make_db3(tmp_path / "good.db3", good_rows([float(i % 40) for i in range(200)])), "rb").read()
+    bad = tmp_path / "bad.db3"
+    seen = set()
+    for k in range(150):
+        data = bytearray(good)
+        for _ in range(rng.randint(1, 40)):
+            pos = rng.randrange(100, len(data))  # past the header's magic: still a SQLite file
+            data[pos] = rng.randrange(256)
+        if k % 5 == 0:
+            data = data[: rng.randrange(100, len(data))]
+        bad.write_bytes(bytes(data))
+        for args in (["check", str(bad), "--spec", SPEC, "--stats"], ["bag", "info", str(bad)]):
+            r = run([rvc, *args])
+            assert r.returncode in (0, 1, 2, 3, 6), (k, args, r.returncode, r.stderr[-500:])
+            seen.add(r.returncode)
+            assert "invalid JSON" not in r.stderr, (k, args, r.stderr[-500:])  # read as a bag, never as text
+            if r.returncode not in (0, 1):
+                assert r.stderr.strip(), (k, args)
+    assert 2 in seen or 3 in seen  # the damage was noticed at least once
