@@ -273,9 +273,12 @@ def test_key_and_payload_are_what_rvc_bridge_forwards(rvc, ros, bridge):
     assert all(len(a) == 17 for _, _, a in ours)  # rvc's seq/flags/publisher attachment (docs/zenoh.md)
 
 
-def test_enforcer_command_reaches_a_ros2_subscription_through_the_plugin(rvc, ros, bridge, tmp_path):
+def test_enforcer_command_reaches_a_ros2_subscription_through_the_plugin(rvc, ros, bridge, tmp_path, capfd):
     """The loop: ROS 2 gears -> plugin -> rvc monitor -> its command on Zenoh (CDR std_msgs/Bool)
-    -> plugin -> a ROS 2 subscription. One violation onset (t4): exactly one command."""
+    -> plugin -> a ROS 2 subscription. One violation onset (t4): exactly one command, and nothing
+    else: the plugin forwards any payload, and an end-of-stream marker's empty one reached the
+    subscription's CycloneDDS as a malformed packet, repeated by the reliable writer (what this
+    participant's CycloneDDS prints on stderr, captured here)."""
     zenoh = pytest.importorskip("zenoh")
     from cyclonedds.domain import DomainParticipant
     from cyclonedds.pub import DataWriter
@@ -319,6 +322,7 @@ def test_enforcer_command_reaches_a_ros2_subscription_through_the_plugin(rvc, ro
     assert [(json.loads(l)["time"], json.loads(l)["value"]) for l in out.lines] == EXPECTED
     assert received == [ros["Bool"](data=True)], received
     assert rc == 1
+    assert "malformed packet" not in capfd.readouterr().err
 
 
 def test_the_bridge_process_stays_on_loopback(bridge):
