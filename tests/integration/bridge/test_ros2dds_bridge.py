@@ -344,3 +344,23 @@ def test_the_bridge_process_stays_on_loopback(bridge):
         else:
             assert host in ("127.0.0.1", "0.0.0.0", "*"), f
             assert not local.endswith(":7446"), f  # Zenoh's scouting port: multicast scouting is off
+
+
+@pytest.mark.parametrize("config, env, message", [
+    ({"listen": {"endpoints": ["tcp/0.0.0.0:7447"]}}, {}, "endpoint 'tcp/0.0.0.0:7447' is not on loopback"),
+    ({"connect": {"endpoints": ["tcp/192.0.2.1:7447"]}}, {}, "endpoint 'tcp/192.0.2.1:7447' is not on loopback"),
+    ({"listen": {"endpoints": []}}, {}, "listen.endpoints is empty"),
+    ({"scouting": {"multicast": {"enabled": True}}}, {}, "scouting.multicast.enabled must be false"),
+    ({"plugins": {}}, {}, "no plugins.ros2dds object"),
+    ({}, {"CYCLONEDDS_URI": ""}, "CYCLONEDDS_URI is not set"),
+], ids=["listen-any", "connect-outer", "listen-empty", "scouting", "no-plugin", "no-dds-pin"])
+def test_the_bridge_refuses_configs_that_leave_loopback(bridge_bin, tmp_path, config, env, message):
+    """Exit 2 with the reason, before anything is opened."""
+    base = {"mode": "router", "listen": {"endpoints": ["tcp/127.0.0.1:7447"]},
+            "scouting": {"multicast": {"enabled": False}}, "plugins": {"ros2dds": {}}}
+    cfg = tmp_path / "bridge.json5"
+    cfg.write_text(json.dumps({**base, **config}))
+    r = subprocess.run([bridge_bin, str(cfg)], capture_output=True, text=True, timeout=HANG_GUARD,
+                       env={**os.environ, "CYCLONEDDS_URI": "file:///dev/null", **env})
+    assert r.returncode == 2 and message in r.stderr, r.stderr
+    assert r.stdout == ""  # never ready
