@@ -14,7 +14,7 @@ nothing.
   cyclonedds-Python back into what was written), no attachment;
 - the reverse: `rvc monitor --on-violation ... --command-type std_msgs/msg/Bool` on Zenoh -> plugin
   -> a ROS 2 subscription in cyclonedds-Python receives exactly one command per onset;
-- the bridge process stays on loopback (its sockets, from `ss`).
+- the bridge process stays on loopback (its sockets, from `ss`), and refuses a config that would not.
 Network: the bridge's CycloneDDS uses rvc's loopback-pinned XML (`rvc dds-config`, checked to name
 `lo`), its Zenoh side listens on one tcp/127.0.0.1 port with multicast scouting off (the bridge
 refuses anything else); every DDS participant is in a domain of its own, drawn per module.
