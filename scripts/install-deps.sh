@@ -35,6 +35,7 @@ TEST_APT_PACKAGES=(
   python3-pip
   iproute2 time
   clang libclang-rt-14-dev  # libFuzzer harnesses and the sanitizer tiers (tests/fuzz)
+  libclang1-14              # tools/ros2dds-bridge: cyclors' bindgen loads libclang at build time (cmake: above)
 )
 if [ "$DEMO_ONLY" = 0 ]; then APT_PACKAGES+=("${TEST_APT_PACKAGES[@]}"); fi
 # Zenoh is a Rust crate: the locked Zenoh dependencies need cargo >= 1.89; Debian's cargo-web (1.96)

@@ -42,6 +42,7 @@ Enforcer::Enforcer(std::vector<EnforceAction> actions, const transport::Transpor
       if (!io::json_to_cdr(*command_type, spec.payload, a.sample, error))
         throw std::invalid_argument("--on-violation " + spec.property + ": payload as " + command_type->full_name() +
                                     ": " + error);
+      a.eos = spec.uri.rfind("zenoh:", 0) != 0;
     }
     a.spec = std::move(spec);
     a.sink = transport::open_sink(a.spec.uri, transports);
@@ -84,7 +85,7 @@ bool Enforcer::wait_subscribers(size_t count, std::chrono::milliseconds timeout,
 
 void Enforcer::finish() {
   for (Action& a : actions_) {
-    a.sink->put_eos(a.sent);
+    if (a.eos) a.sink->put_eos(a.sent);
     a.sink->flush();
   }
 }

@@ -50,7 +50,7 @@ class Enforcer {
   void on_verdict(const engine::Verdict& verdict);
   // Waits for this many subscribers on each network endpoint (false: not in time).
   bool wait_subscribers(size_t count, std::chrono::milliseconds timeout, std::string& which);
-  void finish();  // end-of-stream markers, flush
+  void finish();  // end-of-stream markers (none for typed zenoh commands), flush
 
   uint64_t commands() const { return commands_; }
   uint64_t debounced() const { return debounced_; }
@@ -63,6 +63,9 @@ class Enforcer {
     std::chrono::steady_clock::time_point last{};
     bool fired = false;
     uint64_t sent = 0;  // this endpoint's sequence numbers (its subscribers count losses)
+    // Typed commands on zenoh: end without a marker. Its empty payload would reach ROS 2 subscribers
+    // through zenoh-bridge-ros2dds as an empty, malformed sample (docs/zenoh.md).
+    bool eos = true;
   };
   std::vector<Action> actions_;
   std::unordered_map<std::string, bool> last_value_;  // property -> last verdict
