@@ -27,6 +27,7 @@ TOPICS = [
     ("talker", "/topic"), ("talker", "/rosout"),
     ("cdr_test", "/test_topic"), ("cdr_test", "/array_topic"),
     ("services", "/test_topic1"), ("services", "/test_topic2"),
+    ("services", "/test_service1/_service_event"), ("services", "/test_service2/_service_event"),
 ]
 # MCAP needs rvc's Rust library: deselected where it is not built (RVC_NO_RUST, conftest.py).
 STORAGES = ["sqlite3", pytest.param("mcap", marks=pytest.mark.needs_rust)]
@@ -71,12 +72,23 @@ def typestore_for(folder):
     from rosbags.rosbag2 import Reader
     from rosbags.typesys import Stores, get_typestore
     from rosbags.typesys.msg import get_types_from_msg
-    ts = get_typestore(Stores.ROS2_HUMBLE)
+    ts = get_typestore(Stores.ROS2_JAZZY)  # Jazzy: it has service_msgs (service events)
     twin = os.path.join(BAGS, os.path.basename(folder).rsplit("_", 1)[0] + "_mcap")
     with Reader(twin) as r:
         for c in r.connections:
             if c.msgtype.startswith("test_msgs/msg/") and c.msgdef and c.msgdef.data:
                 ts.register(get_types_from_msg(c.msgdef.data, c.msgtype))
+            elif c.msgtype.startswith("test_msgs/srv/") and c.msgtype.endswith("_Event") and c.msgdef and c.msgdef.data:
+                # rosbag2 records a service event topic's .srv text; rosidl's layout of the three
+                # types it makes, registered under msg names (rosbags renames pkg/srv/ types).
+                base = c.msgtype[len("test_msgs/srv/"):-len("_Event")]
+                request, response = c.msgdef.data.split("\n---\n")
+                ts.register(get_types_from_msg(request, f"test_msgs/msg/{base}_Request"))
+                ts.register(get_types_from_msg(response, f"test_msgs/msg/{base}_Response"))
+                ts.register(get_types_from_msg(
+                    "service_msgs/msg/ServiceEventInfo info\n"
+                    f"test_msgs/msg/{base}_Request[<=1] request\n"
+                    f"test_msgs/msg/{base}_Response[<=1] response\n", f"test_msgs/msg/{base}_Event"))
     return ts
 
 
@@ -98,7 +110,8 @@ def raw_messages(folder, topic):
 def rosbags_messages(folder, topic):
     """[(log time ns, message as plain values)] of one topic, decoded by rosbags."""
     ts = typestore_for(folder)
-    return [(t, plain(ts.deserialize_cdr(raw, msgtype))) for t, msgtype, raw in raw_messages(folder, topic)]
+    return [(t, plain(ts.deserialize_cdr(raw, msgtype.replace("/srv/", "/msg/"))))
+            for t, msgtype, raw in raw_messages(folder, topic)]
 
 
 def same(a, b, path="$"):
