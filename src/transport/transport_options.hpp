@@ -19,6 +19,7 @@ namespace rvc::transport {
 struct TransportOptions {
 #ifdef RVC_HAVE_ZENOH
   ZenohOptions zenoh;
+  RmwZenohOptions rmw_zenoh;
 #endif
 #ifdef RVC_HAVE_DDS
   DdsOptions dds;
