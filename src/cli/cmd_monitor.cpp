@@ -414,12 +414,19 @@ struct MonitorCommand {
                    transport::scheme_of(input).c_str());
       return kUsage;
     }
+    try {
+      typed.infer_from_graph(input, input_transports);  // rmw_zenoh: without --type
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "rvc: %s\n", e.what());
+      return kUsage;
+    }
     popts.type = typed.resolve(input_transports);
     attach_results(input, popts, verdicts);
     runtime::Pipeline pipeline(properties, popts, [&](const engine::Verdict& v) { verdicts.put(v); });
     start_results({input}, properties);
 
     runtime::LoopOptions lopts = loop_options(transport::scheme_of(input) == "file");
+    lopts.per_publisher = transport::scheme_of(input) == "rmw_zenoh";  // GIDs: loss per publisher
     clock.open_ros_clock(lopts, transports);
     record_counters(lopts);
     attach_health(lopts);

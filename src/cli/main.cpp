@@ -53,6 +53,7 @@ int main(int argc, char** argv) {
       {"dashboard", register_dashboard},
 #ifdef RVC_HAVE_ZENOH
       {"router", register_router},
+      {"topics", register_topics},
 #endif
 #ifdef RVC_HAVE_DDS
       {"dds-config", register_dds_config},

@@ -26,7 +26,12 @@ struct TypeOptions {
   // The type (null without --type); sets it as the DDS topics' type in
   // `transports`. Throws msg::MsgError for an unknown type or bad definition.
   const msg::MessageType* resolve(transport::TransportOptions& transports);
-  // Whether a typed endpoint can be `uri`: dds: topics and zenoh: keys.
+  // An rmw_zenoh: input without --type: the type its publishers announce in
+  // the ROS 2 graph (liveliness tokens), printed to stderr. Does nothing for
+  // other inputs or when --type was given. Throws std::invalid_argument when
+  // the graph names no single type.
+  void infer_from_graph(const std::string& uri, const transport::TransportOptions& transports);
+  // Whether a typed endpoint can be `uri`: dds: and rmw_zenoh: topics, zenoh: keys.
   static bool typed_scheme(const std::string& uri);
 };
 

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdlib>
+#include <map>
 
 #include "transport/seq_counter.hpp"
 #include "transport/zenoh/rmw_zenoh_format.hpp"
@@ -77,9 +78,25 @@ TEST(RmwZenohFormat, GidsBecomeDistinctNonZeroPublisherIds) {
   c.expect(2);
   for (uint64_t s : {1, 2, 3}) c.on_seq(s, rz::publisher_id(a));
   for (uint64_t s : {1, 3}) c.on_seq(s, rz::publisher_id(b));
+  c.on_seq(1, rz::publisher_id(a));  // a numbering from 1 again: that publisher restarted
+  c.on_seq(2, rz::publisher_id(a));
   EXPECT_EQ(c.gaps, 1u);
   EXPECT_EQ(c.duplicates, 0u);
+  EXPECT_EQ(c.restarts, 1u);
   EXPECT_EQ(c.publishers(), 2u);
+  // Each publisher's share, as the counters line lists it.
+  std::map<uint64_t, rvc::transport::SeqCounters::Publisher> by;
+  c.each_publisher([&](uint64_t id, const auto& p) { by[id] = p; });
+  ASSERT_EQ(by.size(), 2u);
+  const auto& pa = by.at(rz::publisher_id(a));
+  const auto& pb = by.at(rz::publisher_id(b));
+  EXPECT_EQ(pa.received, 5u);
+  EXPECT_EQ(pa.gaps, 0u);
+  EXPECT_EQ(pa.restarts, 1u);
+  EXPECT_EQ(pa.last_seq, 2u);
+  EXPECT_EQ(pb.received, 2u);
+  EXPECT_EQ(pb.gaps, 1u);
+  EXPECT_EQ(pb.restarts, 0u);
 }
 
 TEST(RmwZenohFormat, LivelinessTokensOfTheDesignDocument) {
