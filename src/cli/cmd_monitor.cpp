@@ -277,7 +277,9 @@ struct MonitorCommand {
     runtime::VerdictOutputs verdicts(std::move(sinks), !check.dense);
     if (verdict_msg_type()) {
       std::vector<bool> typed_sinks;
-      for (const auto& uri : outputs) typed_sinks.push_back(TypeOptions::typed_scheme(uri));
+      // rmw_zenoh: outputs stay std_msgs/String JSON (a typed key needs the type's REP-2016 hash).
+      for (const auto& uri : outputs)
+        typed_sinks.push_back(TypeOptions::typed_scheme(uri) && transport::scheme_of(uri) != "rmw_zenoh");
       verdicts.set_typed(verdict_msg_type(), typed_sinks);
     }
     return verdicts;
