@@ -123,6 +123,7 @@ std::vector<runtime::SyncInput> SyncFlags::resolve(const std::vector<std::string
       TypeOptions from_graph;  // rmw_zenoh: the type its publishers announce
       from_graph.infer_from_graph(out[i].uri, transports);
       type_names[i] = from_graph.type;
+      typed.graph_session = from_graph.graph_session;  // the session stays open for the inputs
     }
     if (type_names[i].empty()) continue;
     if (!TypeOptions::typed_scheme(out[i].uri))

@@ -34,7 +34,8 @@ void TypeOptions::infer_from_graph(const std::string& uri, const transport::Tran
   if (!type.empty() || transport::scheme_of(uri) != "rmw_zenoh") return;
 #ifdef RVC_HAVE_ZENOH
   const std::string topic = uri.substr(uri.find(':') + 1);
-  type = transport::rmw_zenoh_topic_type(topic, transports.zenoh, transports.rmw_zenoh, std::chrono::seconds(3));
+  type = transport::rmw_zenoh_topic_type(topic, transports.zenoh, transports.rmw_zenoh, std::chrono::seconds(3),
+                                         &graph_session);
   std::fprintf(stderr, "rvc: %s: type %s (announced in the ROS 2 graph)\n", uri.c_str(), type.c_str());
 #else
   (void)transports;

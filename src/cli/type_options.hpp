@@ -6,6 +6,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -19,6 +20,7 @@ struct TypeOptions {
   std::vector<std::string> msg_paths;  // --msg-path
   msg::TypeRegistry registry;          // owns the resolved type
   CLI::Option* type_option = nullptr;  // every --type given, in order (several inputs: one each)
+  std::shared_ptr<void> graph_session;  // the session the graph was read with, kept for the input
 
   // `type_help` says what the type applies to in this subcommand.
   void add_to(CLI::App& app, const std::string& type_help);

@@ -138,8 +138,9 @@ std::vector<rmw_zenoh::Entity> rmw_zenoh_graph(const ZenohOptions& opts, int dom
 }
 
 std::string rmw_zenoh_topic_type(const std::string& topic, const ZenohOptions& opts, const RmwZenohOptions& ropts,
-                                 std::chrono::milliseconds wait) {
+                                 std::chrono::milliseconds wait, std::shared_ptr<void>* keep_session) {
   const std::string name = rmw_zenoh::qualified_topic(topic);
+  if (keep_session) *keep_session = ZenohSession::shared(opts);
   const int domain = rmw_zenoh_domain(ropts);
   std::set<std::string> from_publishers, from_subscriptions;
   const auto deadline = std::chrono::steady_clock::now() + wait;

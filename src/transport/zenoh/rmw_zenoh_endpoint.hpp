@@ -35,8 +35,10 @@ std::vector<rmw_zenoh::Entity> rmw_zenoh_graph(const ZenohOptions& opts, int dom
 
 // The ROS type (pkg/msg/Name) of `topic`'s publishers (or, with none, its
 // subscriptions) in the graph. Throws std::invalid_argument naming what was
-// found when there is no single type.
+// found when there is no single type. `keep_session` (if given) holds the
+// session open, so the endpoint opened next shares it instead of opening a
+// second one (peers would meet it anew: samples put meanwhile could be missed).
 std::string rmw_zenoh_topic_type(const std::string& topic, const ZenohOptions& opts, const RmwZenohOptions& ropts,
-                                 std::chrono::milliseconds wait);
+                                 std::chrono::milliseconds wait, std::shared_ptr<void>* keep_session = nullptr);
 
 }  // namespace rvc::transport
