@@ -223,6 +223,14 @@ def test_echo_without_type_and_a_topic_the_graph_does_not_know(rvc, ros, store):
     assert r.returncode == 2
     assert "rmw_zenoh:/not/announced: no publisher or subscription of this topic announced" in r.stderr, r.stderr
     assert "give --type" in r.stderr
+    # Two types announced on one topic: rvc does not guess.
+    sys_.token("MP", "a", "/two/types", "std_msgs::msg::dds_::String_")
+    sys_.token("MP", "b", "/two/types", DDS_GEAR)
+    r = subprocess.run([rvc, "echo", "rmw_zenoh:/two/types", "-n", "1", *sys_.rvc_flags()],
+                       capture_output=True, text=True, timeout=HANG_GUARD)
+    assert r.returncode == 2
+    assert ("rmw_zenoh:/two/types: the graph announces several types (autoware_auto_vehicle_msgs/msg/GearReport, "
+            "std_msgs/msg/String): choose one with --type") in r.stderr, r.stderr
 
 
 def test_verdicts_published_in_rmw_zenoh_format_with_graph_tokens(rvc, tmp_path, ros, zenoh_mod):
@@ -266,3 +274,31 @@ def test_verdicts_published_in_rmw_zenoh_format_with_graph_tokens(rvc, tmp_path,
         assert (seq, gid_len, len(att)) == (i, 16, 33)
     assert len({att[17:] for _, _, att in got}) == 1  # one GID
     assert [json.loads(t)["value"] for t in texts] == [True, True, True, False, True]
+
+
+def test_several_named_inputs_take_their_types_from_the_graph(rvc, ros, store):
+    sys_ = ros()
+    sys_.token("MP", "gear_node", TOPIC, DDS_GEAR)
+    sys_.token("MP", "chatter_node", "/chatter", "std_msgs::msg::dds_::String_")
+    gear_pub = sys_.publisher(TOPIC, DDS_GEAR)
+    chat_pub = sys_.publisher("/chatter", "std_msgs::msg::dds_::String_")
+    mon = subprocess.Popen([rvc, "monitor", "--spec", "{gear.report != 0} && {chat.data == \"ok\"}",
+                            "--input", f"gear=rmw_zenoh:{TOPIC}", "--input", "chat=rmw_zenoh:/chatter",
+                            "--stamp", "chat=arrival", "--idle-timeout", "1.5", *sys_.rvc_flags()],
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        wait_for(lambda: (matched(gear_pub) and matched(chat_pub)) or mon.poll() is not None, "both inputs")
+        for i, (raw, _) in enumerate(gear_samples(store, 4, seed=5), 1):
+            gear_pub.put(raw, attachment=attachment(i, gid_of(1)))
+        text = b"ok"
+        chat_pub.put(b"\x00\x01\x00\x00" + struct.pack("<I", len(text) + 1) + text + b"\x00",
+                     attachment=attachment(1, gid_of(2)))
+        out, err = mon.communicate(timeout=HANG_GUARD)
+    finally:
+        if mon.poll() is None:
+            mon.kill()
+    assert f"rmw_zenoh:{TOPIC}: type {GEAR} (announced in the ROS 2 graph)" in err, err
+    assert "rmw_zenoh:/chatter: type std_msgs/msg/String (announced in the ROS 2 graph)" in err, err
+    s = final_stats(err)
+    by = {i["name"]: i for i in s["inputs"]}
+    assert (by["gear"]["received"], by["chat"]["received"], s["rejected"]) == (4, 1, 0), err
