@@ -341,6 +341,8 @@ struct MonitorCommand {
     clock.open_ros_clock(lopts, transports);
     lopts.input_names = names;
     lopts.input = SyncFlags::joined_names(named);
+    for (const auto& uri : uris)  // rmw_zenoh: GIDs tell publishers apart: list each one's share
+      if (transport::scheme_of(uri) == "rmw_zenoh") lopts.per_publisher = true;
     record_counters(lopts);
     attach_health(lopts);
     set_filter(lopts, uris);

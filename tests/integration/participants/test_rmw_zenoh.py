@@ -302,3 +302,5 @@ def test_several_named_inputs_take_their_types_from_the_graph(rvc, ros, store):
     s = final_stats(err)
     by = {i["name"]: i for i in s["inputs"]}
     assert (by["gear"]["received"], by["chat"]["received"], s["rejected"]) == (4, 1, 0), err
+    shares = {p["publisher"]: p["received"] for p in s["by_publisher"]}
+    assert shares == {publisher_id(gid_of(1)): 4, publisher_id(gid_of(2)): 1}, err
