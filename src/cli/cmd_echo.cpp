@@ -155,7 +155,13 @@ struct EchoCommand {
       }
     }
     if (typed.given() && !TypeOptions::typed_scheme(input)) {
-      std::fprintf(stderr, "rvc: --type reads dds: or zenoh: inputs; for CDR in a file use `rvc msg decode`\n");
+      std::fprintf(stderr, "rvc: --type reads dds:, rmw_zenoh: or zenoh: inputs; for CDR in a file use `rvc msg decode`\n");
+      return kUsage;
+    }
+    try {
+      typed.infer_from_graph(input, transports);  // rmw_zenoh: without --type
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "rvc: %s\n", e.what());
       return kUsage;
     }
     const msg::MessageType* ros_type = typed.resolve(transports);
@@ -236,7 +242,7 @@ struct EchoCommand {
 Runner register_echo(CLI::App& app) {
   auto cmd = std::make_shared<EchoCommand>();
   CLI::App* sub = app.add_subcommand("echo", "Print the messages of an endpoint or a ROS 2 bag's topic as JSON lines (typed ROS 2 topics with --type)");
-  sub->add_option("input", cmd->input, "Endpoint: dds:TOPIC, zenoh:KEYEXPR, file:PATH, or a ROS 2 bag (bag:PATH, a .mcap or .db3 file, a bag folder)")->required();
+  sub->add_option("input", cmd->input, "Endpoint: dds:TOPIC, rmw_zenoh:TOPIC (type from the ROS 2 graph), zenoh:KEYEXPR, file:PATH, or a ROS 2 bag (bag:PATH, a .mcap or .db3 file, a bag folder)")->required();
   cmd->typed.add_to(*sub, "Message type of the samples: ROS 2 pkg/msg/Name (`rvc msg list`) or a DDS IDL name from --msg-path");
   sub->add_option("--field", cmd->fields,
                   "Print only this field of each typed sample, e.g. status.twist (repeatable; the rest is still "

@@ -290,7 +290,9 @@ struct MonitorCommand {
     runtime::VerdictOutputs verdicts(std::move(sinks), !check.dense);
     if (verdict_msg_type()) {
       std::vector<bool> typed_sinks;
-      for (const auto& uri : outputs) typed_sinks.push_back(TypeOptions::typed_scheme(uri));
+      // rmw_zenoh: outputs stay std_msgs/String JSON (a typed key needs the type's REP-2016 hash).
+      for (const auto& uri : outputs)
+        typed_sinks.push_back(TypeOptions::typed_scheme(uri) && transport::scheme_of(uri) != "rmw_zenoh");
       verdicts.set_typed(verdict_msg_type(), typed_sinks);
     }
     return verdicts;
@@ -352,6 +354,8 @@ struct MonitorCommand {
     clock.open_ros_clock(lopts, transports);
     lopts.input_names = names;
     lopts.input = SyncFlags::joined_names(named);
+    for (const auto& uri : uris)  // rmw_zenoh: GIDs tell publishers apart: list each one's share
+      if (transport::scheme_of(uri) == "rmw_zenoh") lopts.per_publisher = true;
     record_counters(lopts);
     attach_health(lopts);
     set_filter(lopts, uris);
@@ -428,12 +432,19 @@ struct MonitorCommand {
                    transport::scheme_of(input).c_str());
       return kUsage;
     }
+    try {
+      typed.infer_from_graph(input, input_transports);  // rmw_zenoh: without --type
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "rvc: %s\n", e.what());
+      return kUsage;
+    }
     popts.type = typed.resolve(input_transports);
     attach_results(input, popts, verdicts);
     runtime::Pipeline pipeline(properties, popts, [&](const engine::Verdict& v) { verdicts.put(v); });
     start_results({input}, properties);
 
     runtime::LoopOptions lopts = loop_options(transport::scheme_of(input) == "file");
+    lopts.per_publisher = transport::scheme_of(input) == "rmw_zenoh";  // GIDs: loss per publisher
     clock.open_ros_clock(lopts, transports);
     record_counters(lopts);
     attach_health(lopts);

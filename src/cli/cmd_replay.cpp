@@ -60,9 +60,9 @@ struct ReplayCommand {
       }
     }
     if (typed.given()) {
-      if (!TypeOptions::typed_scheme(to)) {
-        std::fprintf(stderr, "rvc: --type publishes typed samples to dds: or zenoh: endpoints; for CDR in a file "
-                             "use `rvc msg encode`\n");
+      if (!TypeOptions::typed_scheme(to) || transport::scheme_of(to) == "rmw_zenoh") {
+        std::fprintf(stderr, "rvc: --type publishes typed samples to dds: or zenoh: endpoints (rmw_zenoh: outputs "
+                             "carry JSON as std_msgs/String); for CDR in a file use `rvc msg encode`\n");
         return kUsage;
       }
       if (batch > 1) {

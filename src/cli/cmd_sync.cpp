@@ -111,7 +111,8 @@ struct SyncCommand {
     runtime::VerdictOutputs sets(std::move(sinks), true);
     if (typed_sets) {
       std::vector<bool> typed_sinks;
-      for (const auto& uri : outputs) typed_sinks.push_back(TypeOptions::typed_scheme(uri));
+      for (const auto& uri : outputs)  // rmw_zenoh: outputs stay std_msgs/String JSON
+        typed_sinks.push_back(TypeOptions::typed_scheme(uri) && transport::scheme_of(uri) != "rmw_zenoh");
       sets.set_typed(typed_sets, typed_sinks);
     }
 

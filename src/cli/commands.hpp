@@ -21,6 +21,7 @@ Runner register_timescales(CLI::App& app);
 Runner register_monitor(CLI::App& app);
 Runner register_replay(CLI::App& app);
 Runner register_router(CLI::App& app);      // only with the Zenoh transport
+Runner register_topics(CLI::App& app);      // the ROS 2 graph of rmw_zenoh (Zenoh transport only)
 Runner register_dds_config(CLI::App& app);  // only with the DDS transport
 Runner register_perf(CLI::App& app);
 Runner register_bridge(CLI::App& app);

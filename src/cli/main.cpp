@@ -54,6 +54,7 @@ int main(int argc, char** argv) {
       {"bag", register_bag},
 #ifdef RVC_HAVE_ZENOH
       {"router", register_router},
+      {"topics", register_topics},
 #endif
 #ifdef RVC_HAVE_DDS
       {"dds-config", register_dds_config},

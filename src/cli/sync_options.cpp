@@ -119,6 +119,12 @@ std::vector<runtime::SyncInput> SyncFlags::resolve(const std::vector<std::string
   for (const auto& p : typed.msg_paths) typed.registry.add_search_path(p);
   per_input.assign(out.size(), transports);
   for (size_t i = 0; i < out.size(); ++i) {
+    if (type_names[i].empty() && transport::scheme_of(out[i].uri) == "rmw_zenoh") {
+      TypeOptions from_graph;  // rmw_zenoh: the type its publishers announce
+      from_graph.infer_from_graph(out[i].uri, transports);
+      type_names[i] = from_graph.type;
+      typed.graph_session = from_graph.graph_session;  // the session stays open for the inputs
+    }
     if (type_names[i].empty()) continue;
     if (!TypeOptions::typed_scheme(out[i].uri))
       throw std::invalid_argument("input '" + out[i].name + "': --type reads dds: topics or zenoh: keys, not " +
@@ -126,6 +132,9 @@ std::vector<runtime::SyncInput> SyncFlags::resolve(const std::vector<std::string
     out[i].type = &typed.registry.resolve(type_names[i]);
 #ifdef RVC_HAVE_DDS
     per_input[i].dds.ros_type = out[i].type;
+#endif
+#ifdef RVC_HAVE_ZENOH
+    per_input[i].rmw_zenoh.ros_type = type_names[i];
 #endif
   }
   apply_stamps(out);

@@ -119,6 +119,22 @@ std::string MonitorLoop::stats_json() const {
     }
     out.add_raw("inputs", inputs.str());
   }
+  if (options_.per_publisher) {
+    io::JsonArray by;
+    for (const auto& c : counters_)
+      c.each_publisher([&](uint64_t id, const transport::SeqCounters::Publisher& p) {
+        char hex[17];
+        std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(id));
+        by.add(io::JsonObject()
+                   .add("publisher", std::string(hex))
+                   .add("received", p.received)
+                   .add("gaps", p.gaps)
+                   .add("duplicates", p.duplicates)
+                   .add("last_seq", p.last_seq)
+                   .add("restarts", p.restarts));
+      });
+    out.add_raw("by_publisher", by.str());
+  }
   if (options_.filter) out.add("filtered", filtered_);
   if (options_.clock != ClockKind::Off) {
     out.add("clock", to_string(clock_.kind())).add("ticks", ticks_).add("late_to_clock", p.late_to_clock);

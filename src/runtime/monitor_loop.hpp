@@ -47,6 +47,10 @@ struct LoopOptions {
   std::string input;             // the input's name in the counters line
   // Several inputs: their names (counters per input); empty with one input.
   std::vector<std::string> input_names;
+  // The counters line also lists each publisher's share ("by_publisher":
+  // id, received, gaps, duplicates, restarts): rmw_zenoh inputs, whose GIDs
+  // tell the publishers of a topic apart.
+  bool per_publisher = false;
   bool exit_on_eos = false;      // stop at the publisher's end-of-stream marker
   // With exit_on_eos: how many publishers' markers end the stream. A publisher
   // the monitor has not discovered yet when the others end cannot be waited

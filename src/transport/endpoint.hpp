@@ -2,6 +2,7 @@
 //   file:PATH | PATH | -   (JSON lines)
 //   zenoh:KEYEXPR          (one JSON object per sample)
 //   dds:TOPIC              (ROS 2 std_msgs/msg/String by default)
+//   rmw_zenoh:TOPIC        (ROS 2 over rmw_zenoh_cpp: CDR samples, GIDs; zenoh/rmw_zenoh_endpoint.hpp)
 // A Source delivers Frames to a handler; a Sink publishes payloads. Transport
 // specifics (sessions, QoS, configs) stay behind these two interfaces.
 #pragma once

@@ -7,8 +7,10 @@
 #include "transport/transport_options.hpp"
 #ifdef RVC_HAVE_ZENOH
 #include "transport/zenoh/rvc_zenoh.h"
+#include "transport/zenoh/rmw_zenoh_endpoint.hpp"
 #include "transport/zenoh/zenoh_endpoint.hpp"
 #endif
+#include "transport/zenoh/rmw_zenoh_format.hpp"
 #ifdef RVC_HAVE_DDS
 #include "transport/dds/dds_endpoint.hpp"
 #endif
@@ -28,16 +30,16 @@ Parsed parse(const std::string& uri) {
   // bag:PATH and mcap:PATH both name a ROS 2 bag of any storage (MCAP,
   // sqlite3, a bag folder: transport/rosbag2), told apart by content.
   if (scheme == "bag") scheme = "mcap";
-  if (scheme == "file" || scheme == "zenoh" || scheme == "dds" || scheme == "mcap") {
+  if (scheme == "file" || scheme == "zenoh" || scheme == "dds" || scheme == "mcap" || scheme == "rmw_zenoh") {
     if (rest.empty()) throw std::invalid_argument("endpoint '" + uri + "' names no " +
-                                                  (scheme == "file" || scheme == "mcap" ? "path"
-                                                   : scheme == "dds"                    ? "topic"
-                                                                                        : "key expression"));
+                                                  (scheme == "file" || scheme == "mcap"     ? "path"
+                                                   : scheme == "dds" || scheme == "rmw_zenoh" ? "topic"
+                                                                                              : "key expression"));
     return {scheme, rest};
   }
   if (scheme.size() == 1) return {"file", uri};  // not a scheme: a Windows-like path "C:..."
   throw std::invalid_argument("unknown endpoint scheme '" + scheme + ":' in '" + uri +
-                              "' (use file:PATH, -, zenoh:KEYEXPR, dds:TOPIC or, as an input, bag:BAG)");
+                              "' (use file:PATH, -, zenoh:KEYEXPR, dds:TOPIC, rmw_zenoh:TOPIC or, as an input, bag:BAG)");
 }
 
 [[noreturn, maybe_unused]] void not_built(const std::string& scheme) {
@@ -51,6 +53,9 @@ std::string scheme_of(const std::string& uri) { return parse(uri).scheme; }
 
 bool endpoints_overlap(const std::string& a, const std::string& b) {
   Parsed pa = parse(a), pb = parse(b);
+  // An rmw_zenoh topic is a Zenoh key: <domain>/<topic>/<type>/<hash>, any type.
+  for (Parsed* p : {&pa, &pb})
+    if (p->scheme == "rmw_zenoh") *p = {"zenoh", rmw_zenoh::data_keyexpr(rmw_zenoh::domain_id_from_env(), p->rest)};
   // A bag is a file: writing verdicts over it is reading back one's output.
   if (pa.scheme == "mcap") pa.scheme = "file";
   if (pb.scheme == "mcap") pb.scheme = "file";
@@ -89,6 +94,13 @@ std::unique_ptr<Source> open_source(const std::string& uri, const TransportOptio
   if (p.scheme == "mcap")  // read whole by the runtime (runtime/check_bag.hpp), not as a stream
     throw std::invalid_argument("'" + uri + "': bags are read by rvc check and rvc monitor --input, not here");
   if (p.scheme == "file") return std::make_unique<FileSource>(p.rest);
+  if (p.scheme == "rmw_zenoh") {
+#ifdef RVC_HAVE_ZENOH
+    return make_rmw_zenoh_source(p.rest, options.zenoh, options.rmw_zenoh);
+#else
+    not_built("zenoh");
+#endif
+  }
   if (p.scheme == "zenoh") {
 #ifdef RVC_HAVE_ZENOH
     return make_zenoh_source(p.rest, options.zenoh);
@@ -107,6 +119,13 @@ std::unique_ptr<Sink> open_sink(const std::string& uri, const TransportOptions& 
   Parsed p = parse(uri);
   if (p.scheme == "mcap") throw std::invalid_argument("'" + uri + "': rvc reads bags (bag:, mcap:), it does not write them");
   if (p.scheme == "file") return std::make_unique<FileSink>(p.rest);
+  if (p.scheme == "rmw_zenoh") {
+#ifdef RVC_HAVE_ZENOH
+    return make_rmw_zenoh_sink(p.rest, options.zenoh, options.rmw_zenoh);
+#else
+    not_built("zenoh");
+#endif
+  }
   if (p.scheme == "zenoh") {
 #ifdef RVC_HAVE_ZENOH
     return make_zenoh_sink(p.rest, options.zenoh);

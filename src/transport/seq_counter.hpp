@@ -6,9 +6,11 @@
 // DDS report the same counters.
 #pragma once
 
-#include <cstdint>
+#include <algorithm>
 #include <cstddef>
+#include <cstdint>
 #include <unordered_map>
+#include <vector>
 
 namespace rvc::transport {
 
@@ -36,11 +38,17 @@ class SeqCounters {
   // Every publisher seen so far has sent its end-of-stream marker.
   bool all_ended() const { return ended_ == by_publisher_.size(); }
 
- private:
+  // One publisher's share of the totals (rvc monitor's "by_publisher").
   struct Publisher {
     uint64_t last_seq = 0;
     bool ended = false;
+    uint64_t received = 0, gaps = 0, duplicates = 0, restarts = 0;  // kept across its restarts
   };
+  // Calls f(id, publisher) for every publisher seen, in order of id.
+  template <class F>
+  void each_publisher(F f) const;
+
+ private:
   Publisher& publisher(uint64_t id, uint64_t seq);
 
   std::unordered_map<uint64_t, Publisher> by_publisher_;
@@ -62,8 +70,10 @@ inline SeqCounters::Publisher& SeqCounters::publisher(uint64_t id, uint64_t seq)
   // The same publisher numbering from the start again: it restarted.
   if (seq == 1 && (p.last_seq > 1 || p.ended)) {
     ++restarts;
+    ++p.restarts;
     if (p.ended) --ended_;
-    p = Publisher{};
+    p.last_seq = 0;
+    p.ended = false;
   }
   return p;
 }
@@ -72,11 +82,14 @@ inline void SeqCounters::on_seq(uint64_t seq, uint64_t id) {
   ++received;
   if (seq == 0) return;  // publisher sent no sequence number
   Publisher& p = publisher(id, seq);
+  ++p.received;
   if (seq <= p.last_seq) {
     ++duplicates;
+    ++p.duplicates;
     return;
   }
   gaps += seq - p.last_seq - 1;
+  p.gaps += seq - p.last_seq - 1;
   last_seq += seq - p.last_seq;
   p.last_seq = seq;
 }
@@ -85,6 +98,7 @@ inline void SeqCounters::on_eos(uint64_t publisher_last_seq, uint64_t id) {
   Publisher& p = publisher(id, 0);
   if (publisher_last_seq > p.last_seq) {
     gaps += publisher_last_seq - p.last_seq;
+    p.gaps += publisher_last_seq - p.last_seq;
     last_seq += publisher_last_seq - p.last_seq;
     p.last_seq = publisher_last_seq;
   }
@@ -93,6 +107,14 @@ inline void SeqCounters::on_eos(uint64_t publisher_last_seq, uint64_t id) {
     ++ended_;
   }
   any_ended_ = true;
+}
+
+template <class F>
+void SeqCounters::each_publisher(F f) const {
+  std::vector<uint64_t> ids;
+  for (const auto& [id, p] : by_publisher_) ids.push_back(id);
+  std::sort(ids.begin(), ids.end());
+  for (uint64_t id : ids) f(id, by_publisher_.at(id));
 }
 
 }  // namespace rvc::transport

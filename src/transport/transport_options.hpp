@@ -19,19 +19,20 @@ namespace rvc::transport {
 struct TransportOptions {
 #ifdef RVC_HAVE_ZENOH
   ZenohOptions zenoh;
+  RmwZenohOptions rmw_zenoh;
 #endif
 #ifdef RVC_HAVE_DDS
   DdsOptions dds;
 #endif
 };
 
-// Endpoint URIs: file:PATH | PATH | - | zenoh:KEYEXPR | dds:TOPIC.
+// Endpoint URIs: file:PATH | PATH | - | zenoh:KEYEXPR | dds:TOPIC | rmw_zenoh:TOPIC.
 // Throw std::invalid_argument naming the problem (unknown scheme, a transport
 // not compiled in, an empty key expression).
 std::unique_ptr<Source> open_source(const std::string& uri, const TransportOptions& options);
 std::unique_ptr<Sink> open_sink(const std::string& uri, const TransportOptions& options);
 
-// "zenoh", "dds" or "file".
+// "zenoh", "dds", "rmw_zenoh", "mcap" or "file".
 std::string scheme_of(const std::string& uri);
 
 // Whether what is published on endpoint `b` would be received on endpoint

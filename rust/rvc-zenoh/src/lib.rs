@@ -1025,3 +1025,52 @@ pub unsafe extern "C" fn rvc_zenoh_token_undeclare(t: *mut rvc_zenoh_token) -> c
         Ok(RVC_ZENOH_OK)
     })
 }
+
+// ---------------------------------------------------------------------------
+// Liveliness query (graph discovery: the tokens alive now)
+// ---------------------------------------------------------------------------
+
+pub type rvc_zenoh_key_cb = unsafe extern "C" fn(key: *const u8, key_len: usize, ctx: *mut c_void);
+
+/// Asks the network for the liveliness tokens alive now whose key matches
+/// `key` (rmw_zenoh's graph: "@ros2_lv/0/**"), calling `cb` once per token
+/// on the calling thread. Waits until every peer answered or `timeout_ms`
+/// ran out. Returns the number of tokens (>= 0) or an error code.
+#[no_mangle]
+pub unsafe extern "C" fn rvc_zenoh_liveliness_get(
+    s: *const rvc_zenoh_session,
+    key: *const c_char,
+    timeout_ms: u64,
+    cb: Option<rvc_zenoh_key_cb>,
+    ctx: *mut c_void,
+) -> c_int {
+    guard(|| {
+        let s = handle(s, "session")?;
+        let ke = keyexpr(cstr(key, "keyexpr")?)?;
+        let cb = cb.ok_or_else(|| einval("callback is NULL"))?;
+        let deadline = Instant::now() + Duration::from_millis(timeout_ms);
+        let replies = s
+            .session
+            .liveliness()
+            .get(ke.clone())
+            .timeout(Duration::from_millis(timeout_ms))
+            .wait()
+            .map_err(|e| ezenoh(&format!("liveliness query '{ke}'"), e))?;
+        let mut n: c_int = 0;
+        loop {
+            match replies.recv_deadline(deadline) {
+                Ok(Some(reply)) => {
+                    if let Ok(sample) = reply.result() {
+                        let k = sample.key_expr().as_str();
+                        // SAFETY: the callback borrows the key for the call only.
+                        unsafe { cb(k.as_ptr(), k.len(), ctx) };
+                        n = n.saturating_add(1);
+                    }
+                }
+                Ok(None) => break, // timed out: report what answered
+                Err(_) => break,   // every peer answered
+            }
+        }
+        Ok(n)
+    })
+}

@@ -7,14 +7,15 @@
 #include <thread>
 #include <utility>
 
+#include "transport/zenoh/rmw_zenoh_format.hpp"
 #include "transport/zenoh/seq_attachment.hpp"
 
 namespace rvc::transport {
 
 // ---- ZenohSource -----------------------------------------------------------
 
-ZenohSource::ZenohSource(std::shared_ptr<ZenohSession> session, std::string keyexpr)
-    : session_(std::move(session)), keyexpr_(std::move(keyexpr)) {}
+ZenohSource::ZenohSource(std::shared_ptr<ZenohSession> session, std::string keyexpr, ZenohAttachmentFormat format)
+    : session_(std::move(session)), keyexpr_(std::move(keyexpr)), format_(format) {}
 
 ZenohSource::~ZenohSource() { stop(); }
 
@@ -22,8 +23,24 @@ void ZenohSource::start(FrameHandler handler) {
   if (sub_) throw std::logic_error("ZenohSource::start called twice");
   // Zenoh may deliver from several threads at once (one per link); the seam
   // promises a single transport thread's worth of calls, so serialise them.
-  auto on_sample = [handler = std::move(handler),
+  auto on_sample = [handler = std::move(handler), rmw = format_ == ZenohAttachmentFormat::RmwZenoh,
                     mu = std::make_shared<std::mutex>()](const ZenohSample& s) {
+    if (rmw) {
+      // rmw_zenoh: no end-of-stream marker; a sample without a valid
+      // attachment is counted with seq 0 (not accounted), like a plain one.
+      const auto a = rmw_zenoh::decode_attachment(reinterpret_cast<const uint8_t*>(s.attachment.data()),
+                                                  s.attachment.size());
+      Frame f;
+      if (a && a->seq > 0) {
+        f.seq = static_cast<uint64_t>(a->seq);
+        f.publisher = rmw_zenoh::publisher_id(a->gid);
+      }
+      f.payload = s.payload;
+      f.key = s.key;
+      std::lock_guard lock(*mu);
+      handler(f);
+      return;
+    }
     const auto a = decode_seq_attachment(reinterpret_cast<const uint8_t*>(s.attachment.data()),
                                          s.attachment.size());
     Frame f;

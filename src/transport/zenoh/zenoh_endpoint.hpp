@@ -19,9 +19,15 @@ namespace rvc::transport {
 // Subscribes to a key expression. Samples with an rvc attachment carry their
 // seq (and EOS flag); samples without one get seq 0. Delete samples are ignored.
 // Handler calls never overlap (serialised even when several links deliver).
+// Which attachment the samples carry: rvc's own (seq_attachment.hpp) or
+// rmw_zenoh's (seq, source timestamp, GID: rmw_zenoh_format.hpp), whose GID
+// becomes the frame's publisher.
+enum class ZenohAttachmentFormat { Rvc, RmwZenoh };
+
 class ZenohSource : public Source {
  public:
-  ZenohSource(std::shared_ptr<ZenohSession> session, std::string keyexpr);
+  ZenohSource(std::shared_ptr<ZenohSession> session, std::string keyexpr,
+              ZenohAttachmentFormat format = ZenohAttachmentFormat::Rvc);
   ~ZenohSource() override;
   void start(FrameHandler handler) override;
   void stop() override;
@@ -30,6 +36,7 @@ class ZenohSource : public Source {
  private:
   std::shared_ptr<ZenohSession> session_;
   std::string keyexpr_;
+  ZenohAttachmentFormat format_;
   std::unique_ptr<ZenohSubscriber> sub_;
 };
 

@@ -23,5 +23,12 @@ struct ZenohOptions {
   bool express = false;  // publishers: send each sample at once, no batching
 };
 
+// rmw_zenoh: endpoints (ROS 2 over rmw_zenoh_cpp, docs/zenoh.md): what the
+// data key needs beyond the topic. Kept apart from ZenohOptions, which keys
+// the shared sessions.
+struct RmwZenohOptions {
+  int domain = -1;       // -1: ROS_DOMAIN_ID (unset: 0)
+  std::string ros_type;  // pkg/msg/Name from --type or the graph; empty: any type on the topic
+};
 
 }  // namespace rvc::transport

@@ -168,6 +168,17 @@ ZenohPublisher::ZenohPublisher(std::shared_ptr<ZenohSession> session, const std:
         "declaring publisher on '" + keyexpr + "'");
 }
 
+std::vector<std::string> ZenohSession::liveliness_get(const std::string& keyexpr,
+                                                     std::chrono::milliseconds timeout) const {
+  std::vector<std::string> keys;
+  auto on_key = [](const uint8_t* key, size_t len, void* ctx) {
+    static_cast<std::vector<std::string>*>(ctx)->emplace_back(reinterpret_cast<const char*>(key), len);
+  };
+  check(rvc_zenoh_liveliness_get(s_, keyexpr.c_str(), static_cast<uint64_t>(timeout.count()), on_key, &keys),
+        "liveliness query '" + keyexpr + "'");
+  return keys;
+}
+
 ZenohLivelinessToken::ZenohLivelinessToken(std::shared_ptr<ZenohSession> session, const std::string& keyexpr)
     : session_(std::move(session)) {
   if (!session_) throw ZenohError("zenoh: liveliness token needs a session");

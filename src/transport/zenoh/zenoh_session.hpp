@@ -13,6 +13,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 #include <string_view>
 
 #include "transport/zenoh/zenoh_options.hpp"
@@ -54,6 +55,9 @@ class ZenohSession {
 
   std::string zid() const;
   rvc_zenoh_session* raw() const { return s_; }
+  // The keys of the liveliness tokens alive now that match `keyexpr` (graph
+  // discovery), waiting at most `timeout` for the peers' answers.
+  std::vector<std::string> liveliness_get(const std::string& keyexpr, std::chrono::milliseconds timeout) const;
 
  private:
   explicit ZenohSession(rvc_zenoh_session* s) : s_(s) {}
