@@ -25,6 +25,7 @@
 #include "runtime/forwarder.hpp"
 #include "runtime/message_filter.hpp"
 #include "runtime/monitor_loop.hpp"
+#include "runtime/service_call_feed.hpp"
 #include "runtime/synced_pipeline.hpp"
 #ifdef RVC_HAVE_MCAP
 #include "cli/bag_run.hpp"
@@ -214,8 +215,12 @@ struct MonitorCommand {
       runtime::check_specs(properties, check.dense);
     start_results({input}, properties);
     for (const auto& dir : typed.msg_paths) typed.registry.add_search_path(dir);  // what the schemas leave out
-    BagRun run =
-        cli::run_bag(path, topics, properties, popts, sync, typed.registry, verdicts, clock.ticks_at_end(check.dense));
+    if (check.calls && topics.size() > 1) {
+      std::fprintf(stderr, "rvc: --calls pairs the events of one service topic (--topic /svc/_service_event)\n");
+      return kUsage;
+    }
+    BagRun run = cli::run_bag(path, topics, properties, popts, sync, typed.registry, verdicts,
+                              clock.ticks_at_end(check.dense || check.calls), check.calls_timeout());
     std::fprintf(stderr, "rvc monitor: %s\n", run.description.c_str());
     const std::string stats = run.counters_json(input, verdicts.count());
     std::fprintf(stderr, "%s\n", stats.c_str());
@@ -286,6 +291,10 @@ struct MonitorCommand {
   // Several named inputs: synchronized into one stream in this process.
   int run_synced() {
     auto properties = check.properties();
+    if (check.calls) {
+      std::fprintf(stderr, "rvc: --calls pairs the events of one service: give one --input\n");
+      return kUsage;
+    }
     if (!topics.empty()) {
       std::fprintf(stderr, "rvc: --topic chooses a topic of a bag (--input mcap:PATH)\n");
       return kUsage;
@@ -371,7 +380,7 @@ struct MonitorCommand {
     lopts.queue_capacity = queue_capacity;
     lopts.stop_requested = stop_requested;
     lopts.stats_requested = stats_requested;
-    clock.apply(lopts, check.dense, from_file);
+    clock.apply(lopts, check.dense || check.calls, from_file);  // --calls: unanswered calls are due on the clock
     return lopts;
   }
 
@@ -415,8 +424,21 @@ struct MonitorCommand {
       return kUsage;
     }
     popts.type = typed.resolve(input_transports);
+    // --calls: the input's events are paired into calls; the properties read the calls (JSON).
+    const msg::MessageType* event_type = popts.type;
+    if (check.calls) {
+      if (!forward_property.empty()) {
+        std::fprintf(stderr, "rvc: --forward republishes the input's messages; with --calls the properties check calls\n");
+        return kUsage;
+      }
+      popts.type = nullptr;
+    }
     attach_results(input, popts, verdicts);
     runtime::Pipeline pipeline(properties, popts, [&](const engine::Verdict& v) { verdicts.put(v); });
+    std::unique_ptr<runtime::ServiceCallFeed> call_feed;
+    if (check.calls)
+      call_feed = std::make_unique<runtime::ServiceCallFeed>(pipeline, event_type, check.service_timeout,
+                                                              popts.max_reported);
     start_results({input}, properties);
 
     runtime::LoopOptions lopts = loop_options(transport::scheme_of(input) == "file");
@@ -435,7 +457,9 @@ struct MonitorCommand {
       std::fprintf(stderr, "rvc monitor: messages that keep %s true go on to %s\n", forward_property.c_str(),
                    to.c_str());
     }
-    runtime::Feed& feed = forwarder ? static_cast<runtime::Feed&>(*forwarder) : pipeline;
+    runtime::Feed& feed = forwarder   ? static_cast<runtime::Feed&>(*forwarder)
+                          : call_feed ? static_cast<runtime::Feed&>(*call_feed)
+                                      : pipeline;
     runtime::MonitorLoop loop(feed, verdicts, stats_sink.get(), lopts);
 
     auto source = transport::open_source(input, input_transports);
