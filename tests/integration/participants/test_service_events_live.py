@@ -115,3 +115,55 @@ def test_service_events_over_dds_become_calls(rvc, tmp_path, monkeypatch):
         for p in (echo, calls):
             if p.poll() is None:
                 p.kill()
+
+
+def test_monitor_calls_pairs_service_events_over_dds_and_settles_unanswered_on_its_clock(rvc, tmp_path, monkeypatch):
+    """`rvc monitor --calls`: the same pairing inside the monitor, one command. An answered call is
+    checked as it is answered; a request never answered is checked as answered:false when the monitor's
+    clock (wall: the stamps are the system clock's) passes its deadline, with no further event."""
+    if "dds" not in transports_built(rvc):
+        pytest.skip("rvc built without DDS")
+    loopback_dds(rvc, tmp_path, monkeypatch)  # before any Python participant exists
+    pytest.importorskip("cyclonedds")
+    from cyclonedds.domain import DomainParticipant
+    from cyclonedds.pub import DataWriter
+    from cyclonedds.qos import Policy, Qos
+    from cyclonedds.topic import Topic
+    from cyclonedds.util import duration
+    Time_, Info_, Req_, Resp_, Event_ = set_bool_event_types()
+    domain = 100 + os.getpid() % 50
+    mon = subprocess.Popen([rvc, "monitor", "--input", "dds:/set_bool/_service_event", "--type",
+                            "std_srvs/srv/SetBool_Event", "--calls", "--service-timeout", "1.5", "--all",
+                            "--spec", "{answered} and {latency <= 0.1}", "--domain", str(domain)],
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        dp = DomainParticipant(domain)
+        qos = Qos(Policy.Reliability.Reliable(duration(seconds=30)), Policy.History.KeepAll,
+                  Policy.Durability.Volatile)
+        writer = DataWriter(dp, Topic(dp, "rt/set_bool/_service_event", Event_), qos=qos)
+        wait_for(lambda: dds_matched(writer), "rvc monitor to match the service event topic")
+        now_ns = time.time_ns()
+
+        def info(kind, ns, client, seq):
+            return Info_(event_type=kind, stamp=Time_(sec=ns // 10**9, nanosec=ns % 10**9),
+                         client_gid=[client] + [0] * 15, sequence_number=seq)
+        writer.write(Event_(info=info(0, now_ns, 1, 1), request=[Req_(data=True)], response=[]))
+        writer.write(Event_(info=info(1, now_ns + 1_000_000, 1, 1), request=[Req_(data=True)], response=[]))
+        writer.write(Event_(info=info(2, now_ns + 40_000_000, 1, 1), request=[],
+                            response=[Resp_(success=True, message="set")]))
+        writer.write(Event_(info=info(0, now_ns + 100_000_000, 2, 1), request=[Req_(data=False)], response=[]))
+        first = json.loads(read_line(mon))
+        assert first["value"] is True
+        second = json.loads(read_line(mon))  # client 2's call, made by the monitor's clock at its deadline
+        assert second["value"] is False and mon.poll() is None
+        mon.send_signal(signal.SIGINT)
+        out, err = mon.communicate(timeout=HANG_GUARD)
+        assert mon.returncode == 1, err
+        counters = json.loads([l for l in err.splitlines() if l.startswith("{")][-1])
+        # 4 events = 3 paired (2 calls) + 1 duplicate (the server's REQUEST_RECEIVED)
+        assert counters["received"] == 4 and counters["checked"] == 2 and counters["rejected"] == 0
+        assert counters["dropped"] == {"duplicate": 1}
+        assert counters["calls"]["paired"] == 3 and counters["calls"]["unanswered"] == 1
+    finally:
+        if mon.poll() is None:
+            mon.kill()
