@@ -1,6 +1,7 @@
 #include "runtime/service_call_feed.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 
@@ -15,20 +16,73 @@ ServiceCallFeed::ServiceCallFeed(Pipeline& inner, const msg::MessageType* event_
       calls_(timeout, [this](const std::string& call) { inner_.feed_input(0, call, ++made_); }),
       max_reported_(max_reported) {}
 
-void ServiceCallFeed::feed_input(uint32_t, std::string_view payload, uint64_t position) {
+ServiceCallFeed::ServiceCallFeed(Pipeline& inner, const msg::MessageType& request_type,
+                                 const msg::MessageType& response_type, double timeout, size_t max_reported)
+    : ServiceCallFeed(inner, nullptr, timeout, max_reported) {
+  request_type_ = &request_type;
+  response_type_ = &response_type;
+}
+
+void ServiceCallFeed::reject(uint64_t position) {
+  const std::string why = error_;
+  calls_.feed("", error_);  // counted as a rejected event, as ServiceCalls counts a line that is no event
+  if (calls_.counts().rejected <= max_reported_)
+    std::fprintf(stderr, "rvc: service event %llu: %s (skipped)\n", static_cast<unsigned long long>(position),
+                 why.c_str());
+}
+
+bool ServiceCallFeed::wire_event(uint32_t input, std::string_view payload) {
+  const bool request = input == 0;
+  const msg::MessageType& type = request ? *request_type_ : *response_type_;
+  constexpr size_t kEncapsulation = 4, kHeader = 16;
+  if (payload.size() < kEncapsulation + kHeader) {
+    error_ = std::string(request ? "request" : "reply") + " sample of " + std::to_string(payload.size()) +
+             " bytes: shorter than the encapsulation and the 16-byte request header";
+    return false;
+  }
+  const bool little = payload[1] & 1;  // CDR_LE 00 01, CDR_BE 00 00
+  auto read64 = [&](size_t at) {
+    uint64_t v = 0;
+    for (size_t i = 0; i < 8; ++i) {
+      const uint64_t byte = static_cast<unsigned char>(payload[at + i]);
+      v |= little ? byte << (8 * i) : byte << (8 * (7 - i));
+    }
+    return v;
+  };
+  const uint64_t guid = read64(kEncapsulation);
+  const int64_t seq = static_cast<int64_t>(read64(kEncapsulation + 8));
+  // The fields follow the header; alignment counts from the encapsulation's
+  // end, and 16 keeps it, so the sample without the header decodes as the type.
+  std::string sample(payload.substr(0, kEncapsulation));
+  sample.append(payload.substr(kEncapsulation + kHeader));
+  body_.clear();
+  io::CdrError cdr;
+  if (!io::cdr_to_json(type, sample, body_, cdr)) {
+    error_ = "not a " + std::string(request ? "request" : "reply") + " sample of " + type.full_name() +
+             " after the request header: " + cdr.to_string();
+    return false;
+  }
+  const int64_t now = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                          std::chrono::system_clock::now().time_since_epoch())
+                          .count();
+  json_ = "{\"info\":{\"event_type\":" + std::string(request ? "0" : "2") + ",\"stamp\":{\"sec\":" +
+          std::to_string(now / 1000000000) + ",\"nanosec\":" + std::to_string(now % 1000000000) +
+          "},\"client_gid\":[" + std::to_string(guid) + "],\"sequence_number\":" + std::to_string(seq) + "},\"" +
+          (request ? "request" : "response") + "\":[" + body_ + "]}";
+  return true;
+}
+
+void ServiceCallFeed::feed_input(uint32_t input, std::string_view payload, uint64_t position) {
   std::string_view json = payload;
-  if (type_) {
+  if (request_type_) {
+    if (!wire_event(input, payload)) return reject(position);
+    json = json_;
+  } else if (type_) {
     json_.clear();
     io::CdrError cdr;
     if (!io::cdr_to_json(*type_, payload, json_, cdr)) {
-      json_ = "not a CDR sample of " + type_->full_name() + ": " + cdr.to_string();
-      // counted as a rejected event, as ServiceCalls counts a line that is no event
-      calls_.feed("", error_);
-      error_ = json_;
-      if (calls_.counts().rejected <= max_reported_)
-        std::fprintf(stderr, "rvc: service event %llu: %s (skipped)\n", static_cast<unsigned long long>(position),
-                     error_.c_str());
-      return;
+      error_ = "not a CDR sample of " + type_->full_name() + ": " + cdr.to_string();
+      return reject(position);
     }
     json = json_;
   }

@@ -32,6 +32,14 @@ class ServiceCallFeed final : public Feed {
   // `event_type`: the events are CDR samples of this pkg/srv/Name_Event
   // (null: JSON). `inner` is a JSON pipeline of the calls.
   ServiceCallFeed(Pipeline& inner, const msg::MessageType* event_type, double timeout, size_t max_reported = 100);
+  // The call itself (rmw_cyclonedds' rq/<svc>Request and rr/<svc>Reply): input 0
+  // carries requests, input 1 replies, CDR samples of pkg/srv/Name_Request /
+  // _Response each led by the 16-byte request header (uint64 client guid, int64
+  // sequence number) after the encapsulation. Each becomes a REQUEST_SENT or
+  // RESPONSE_SENT event stamped with its arrival (the system clock when the
+  // engine takes it: these samples carry no stamp), so latency is by arrival.
+  ServiceCallFeed(Pipeline& inner, const msg::MessageType& request_type, const msg::MessageType& response_type,
+                  double timeout, size_t max_reported = 100);
 
   void feed_input(uint32_t input, std::string_view payload, uint64_t position) override;
   void warn(const io::LineError& warning) override { inner_.warn(warning); }
@@ -54,8 +62,15 @@ class ServiceCallFeed final : public Feed {
   uint64_t pending_events() const;
 
  private:
+  // A request or reply sample as a service event (JSON in json_); false with error_.
+  bool wire_event(uint32_t input, std::string_view payload);
+  void reject(uint64_t position);
+
   Pipeline& inner_;
   const msg::MessageType* type_;
+  const msg::MessageType* request_type_ = nullptr;   // wire mode: both set
+  const msg::MessageType* response_type_ = nullptr;
+  std::string body_;
   io::ServiceCalls calls_;
   size_t max_reported_;
   uint64_t made_ = 0;  // calls fed to the inner pipeline: their positions
