@@ -1,32 +1,44 @@
 #include "cli/bag_run.hpp"
 
+#include <memory>
+
 #include "cli/signals.hpp"
+#include "runtime/service_call_feed.hpp"
 
 namespace rvc::cli {
 
 BagRun run_bag(const std::string& path, const std::vector<std::string>& topics,
                const std::vector<engine::PropertySpec>& properties, runtime::PipelineOptions options,
                const SyncFlags& sync, msg::TypeRegistry& registry, runtime::VerdictOutputs& outputs,
-               bool tick_at_end) {
+               bool tick_at_end, double calls_timeout) {
   BagRun run;
   install_stop_signals();
   options.position_name = "message";
   auto on_verdict = [&](const engine::Verdict& v) { outputs.put(v); };
   if (topics.size() <= 1 && (topics.empty() || topics[0].find('=') == std::string::npos || topics[0][0] == '/')) {
     const runtime::BagInput bag = runtime::select_bag_topic(path, topics.empty() ? "" : topics[0], registry);
-    options.type = bag.type;
+    const bool calls = calls_timeout > 0;
+    options.type = calls ? nullptr : bag.type;  // --calls: the properties read the calls, JSON
     runtime::Pipeline pipeline(properties, options, on_verdict);
+    std::unique_ptr<runtime::ServiceCallFeed> call_feed;
+    if (calls) call_feed = std::make_unique<runtime::ServiceCallFeed>(pipeline, bag.type, calls_timeout, options.max_reported);
+    runtime::Feed& feed = call_feed ? static_cast<runtime::Feed&>(*call_feed) : pipeline;
     run.messages = bag.messages;
     run.topic = bag.topic;
     run.description = "topic " + bag.topic + " (" + (bag.type ? bag.type->full_name() : std::string("JSON")) + ", " +
-                      std::to_string(bag.messages) + " messages)";
+                      std::to_string(bag.messages) + " messages" + (calls ? ", paired into calls" : "") + ")";
     uint64_t skipped = 0;
-    run.outcome = runtime::check_bag({bag}, pipeline, outputs, skipped, stop_requested, tick_at_end);
+    run.outcome = runtime::check_bag({bag}, feed, outputs, skipped, stop_requested, tick_at_end);
     run.stopped = stop_requested();
-    run.stats = pipeline.stats();
+    run.stats = feed.stats();
     run.stats.rejected += skipped;  // the bag's bad records: rejected input like a malformed message
-    run.violations = pipeline.violations();
-    run.received = pipeline.received() + skipped;  // a bad record was read and rejected: counts add up
+    run.violations = feed.violations();
+    run.received = feed.received() + skipped;  // a bad record was read and rejected: counts add up
+    feed.add_dropped(run.dropped);
+    if (call_feed) {
+      run.has_calls = true;
+      run.calls = call_feed->call_counts();
+    }
     if (run.stats.accepted == 0 && run.stats.rejected > 0) runtime::hint_bag_definition(bag);
     return run;
   }
@@ -54,8 +66,8 @@ BagRun run_bag(const std::string& path, const std::vector<std::string>& topics,
 }
 
 std::string BagRun::counters_json(const std::string& input, uint64_t verdicts) const {
-  return io::JsonObject()
-      .add("input", input)
+  io::JsonObject out;
+  out.add("input", input)
       .add("topic", topic)
       .add("messages", messages)
       .add("received", received)
@@ -64,8 +76,9 @@ std::string BagRun::counters_json(const std::string& input, uint64_t verdicts) c
       .add("dropped", dropped)
       .add("warnings", stats.warnings)
       .add("verdicts", verdicts)
-      .add("violations", violations)
-      .str();
+      .add("violations", violations);
+  if (has_calls) out.add("calls", calls);
+  return out.str();
 }
 
 }  // namespace rvc::cli

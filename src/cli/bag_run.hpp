@@ -24,6 +24,8 @@ struct BagRun {
   std::string topic;        // the chosen topic (several: joined by ",")
   std::string description;  // "topic /a (pkg/msg/T, 12 messages)", or the inputs
   bool stopped = false;     // a stop signal ended the bag before its end
+  io::JsonObject calls;     // --calls: the service events' counts (runtime/service_call_feed.hpp)
+  bool has_calls = false;
 
   // The run's counters as one JSON object, the fields of the monitor's line
   // (received = checked + rejected + dropped), for `check --stats` and `monitor`.
@@ -34,10 +36,11 @@ struct BagRun {
 // with several topics. SIGINT/SIGTERM end the bag where it is (what was read
 // is checked; the outcome is incomplete), as they end every other input.
 // `tick_at_end` (dense time, --clock auto): the bag's own clock ticks at its
-// end (runtime::check_bag).
+// end (runtime::check_bag). `calls_timeout` > 0 (--calls): the one topic is a
+// service's events, paired into calls that the properties check.
 BagRun run_bag(const std::string& path, const std::vector<std::string>& topics,
                const std::vector<engine::PropertySpec>& properties, runtime::PipelineOptions options,
                const SyncFlags& sync, msg::TypeRegistry& registry, runtime::VerdictOutputs& outputs,
-               bool tick_at_end = false);
+               bool tick_at_end = false, double calls_timeout = 0);
 
 }  // namespace rvc::cli

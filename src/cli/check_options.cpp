@@ -32,6 +32,16 @@ void CheckOptions::add_to(CLI::App& app) {
       ->capture_default_str();
   app.add_option("--max-errors", max_reported, "Errors and warnings printed before going quiet (all are counted)")
       ->capture_default_str();
+  app.add_flag("--calls", calls,
+               "The input is a ROS 2 service's events (<service>/_service_event, pkg/srv/Name_Event): pair request "
+               "and response by info.client_gid + info.sequence_number and check one message per call, as `rvc calls` "
+               "writes it: {time, request_time, answered, latency, sequence_number, request, response} "
+               "(docs/services.md)");
+  app.add_option("--service-timeout", service_timeout,
+                                 "With --calls: seconds after its request a call with no response is made "
+                                 "answered:false (by the events' stamps, or the monitor's clock)")
+                      ->check(CLI::PositiveNumber)
+                      ->capture_default_str();
   app.add_flag("--parse-only", parse_only, "Decode messages but run no monitor (the benchmark's floor)")
       ->group("");  // hidden: for bench/, not for users
   app.add_flag("--no-layouts", no_layouts, "Parse every message with simdjson (no layout fast path)")

@@ -27,11 +27,15 @@ struct CheckOptions {
   bool robustness = false;
   bool explain = false;
   uint32_t max_data_values = 100000;
+  bool calls = false;           // --calls: the input is a service's events, checked as calls (docs/services.md)
+  double service_timeout = 1;   // --service-timeout: a request unanswered this long is a call answered:false
 
   void add_to(CLI::App& app);
   // The properties from --spec (named p1, p2, ...) and --properties.
   std::vector<engine::PropertySpec> properties() const;
   PipelineOptions pipeline_options() const;
+  // --calls: the timeout (0 without --calls).
+  double calls_timeout() const { return calls ? service_timeout : 0; }
 };
 
 }  // namespace rvc::cli

@@ -65,6 +65,11 @@ struct CheckCommand {
                      path.c_str(), what.c_str());
         return kUsage;
       }
+    if (check.calls) {
+      std::fprintf(stderr, "rvc: --calls pairs the service events of a bag's topic (or a live input: rvc monitor "
+                           "--calls); for JSON lines pipe them through `rvc calls` into `rvc check -`\n");
+      return kUsage;
+    }
     if (!topics.empty() || !msg_paths.empty()) {
       std::fprintf(stderr, "rvc: %s a bag (MCAP, sqlite3 or a bag folder); '%s' is a JSON-lines trace\n",
                    topics.empty() ? "--msg-path gives the message definitions of" : "--topic chooses a topic of",
@@ -138,7 +143,13 @@ struct CheckCommand {
       results->attach(input, popts, outputs);
       results->start(runtime::run_info(command_line(), {input}, properties, check.dense));
     }
-    BagRun run = cli::run_bag(path, topics, properties, popts, sync, registry, outputs, clock.ticks_at_end(check.dense));
+    if (check.calls && topics.size() > 1) {
+      std::fprintf(stderr, "rvc: --calls pairs the events of one service topic (--topic /svc/_service_event)\n");
+      return kUsage;
+    }
+    // --calls: a tick at the recording's end also in discrete time, so a request unanswered by then is made
+    BagRun run = cli::run_bag(path, topics, properties, popts, sync, registry, outputs,
+                              clock.ticks_at_end(check.dense || check.calls), check.calls_timeout());
     if (summary) std::fprintf(stderr, "rvc check: %s, %s\n", path.c_str(), run.description.c_str());
     report(run.stats, run.violations);
     if (stats) std::fprintf(stderr, "%s\n", run.counters_json(input, outputs.count()).c_str());

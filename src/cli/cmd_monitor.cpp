@@ -20,11 +20,13 @@
 #include "cli/output_sinks.hpp"
 #include "cli/sync_options.hpp"
 #include "cli/type_options.hpp"
+#include "msg/service_types.hpp"
 #include "msg/type_registry.hpp"
 #include "runtime/enforcer.hpp"
 #include "runtime/forwarder.hpp"
 #include "runtime/message_filter.hpp"
 #include "runtime/monitor_loop.hpp"
+#include "runtime/service_call_feed.hpp"
 #include "runtime/synced_pipeline.hpp"
 #include "cli/bag_run.hpp"
 #include "transport/rosbag2/bag_reader.hpp"
@@ -234,8 +236,12 @@ struct MonitorCommand {
       runtime::check_specs(properties, check.dense);
     start_results({input}, properties);
     for (const auto& dir : typed.msg_paths) typed.registry.add_search_path(dir);  // what the schemas leave out
-    BagRun run =
-        cli::run_bag(path, topics, properties, popts, sync, typed.registry, verdicts, clock.ticks_at_end(check.dense));
+    if (check.calls && topics.size() > 1) {
+      std::fprintf(stderr, "rvc: --calls pairs the events of one service topic (--topic /svc/_service_event)\n");
+      return kUsage;
+    }
+    BagRun run = cli::run_bag(path, topics, properties, popts, sync, typed.registry, verdicts,
+                              clock.ticks_at_end(check.dense || check.calls), check.calls_timeout());
     std::fprintf(stderr, "rvc monitor: %s\n", run.description.c_str());
     const std::string stats = run.counters_json(input, verdicts.count());
     std::fprintf(stderr, "%s\n", stats.c_str());
@@ -301,6 +307,10 @@ struct MonitorCommand {
   // Several named inputs: synchronized into one stream in this process.
   int run_synced() {
     auto properties = check.properties();
+    if (check.calls) {
+      std::fprintf(stderr, "rvc: --calls pairs the events of one service: give one --input\n");
+      return kUsage;
+    }
     if (!topics.empty()) {
       std::fprintf(stderr, "rvc: --topic chooses a topic of a bag (--input bag:PATH)\n");
       return kUsage;
@@ -388,8 +398,71 @@ struct MonitorCommand {
     lopts.queue_capacity = queue_capacity;
     lopts.stop_requested = stop_requested;
     lopts.stats_requested = stats_requested;
-    clock.apply(lopts, check.dense, from_file);
+    clock.apply(lopts, check.dense || check.calls, from_file);  // --calls: unanswered calls are due on the clock
     return lopts;
+  }
+
+  static bool ends_with(const std::string& s, const std::string& end) {
+    return s.size() >= end.size() && s.compare(s.size() - end.size(), end.size(), end) == 0;
+  }
+
+  // --calls --type pkg/srv/Name --input dds:/svc: the call itself, read from
+  // rmw_cyclonedds' rq/svcRequest and rr/svcReply (input 0 and 1), paired by
+  // the request header (runtime/service_call_feed.hpp, docs/services.md).
+  int run_service_wire(const std::vector<engine::PropertySpec>& properties, runtime::PipelineOptions popts,
+                       runtime::VerdictOutputs& verdicts, transport::Sink* stats_sink) {
+#ifdef RVC_HAVE_DDS
+    if (transport::scheme_of(input) != "dds" || !transports.dds.ros2 || !forward_property.empty()) {
+      std::fprintf(stderr, "rvc: --calls with a service type (%s) reads the request and reply topics of a ROS 2 "
+                           "service over DDS: --input dds:/SERVICE (ROS 2 names, no --forward); for service events "
+                           "give --type %s_Event\n", typed.type.c_str(), typed.type.c_str());
+      return kUsage;
+    }
+    for (const auto& p : typed.msg_paths) typed.registry.add_search_path(p);
+    const msg::MessageType& request = typed.registry.resolve(typed.type + "_Request");
+    const msg::MessageType& response = typed.registry.resolve(typed.type + "_Response");
+    const msg::MessageType request_wire = msg::with_request_header(request);
+    const msg::MessageType response_wire = msg::with_request_header(response);
+    const std::string service = transport::dds::dds_topic_name(input.substr(4), true).substr(3);  // "rt/a/b" -> "a/b"
+    const std::vector<std::string> uris = {"dds:rq/" + service + "Request", "dds:rr/" + service + "Reply"};
+    std::vector<transport::TransportOptions> per(2, transports);
+    for (auto& t : per) t.dds.ros2 = false;  // the names above are DDS names already
+    per[0].dds.ros_type = &request_wire;
+    per[1].dds.ros_type = &response_wire;
+    popts.type = nullptr;
+    attach_results(input, popts, verdicts);
+    runtime::Pipeline pipeline(properties, popts, [&](const engine::Verdict& v) { verdicts.put(v); });
+    runtime::ServiceCallFeed feed(pipeline, request, response, check.service_timeout, popts.max_reported);
+    start_results({input}, properties);
+    runtime::LoopOptions lopts = loop_options(false);
+    clock.open_ros_clock(lopts, transports);
+    lopts.input = input;
+    lopts.input_names = {"request", "reply"};
+    record_counters(lopts);
+    attach_health(lopts);
+    set_filter(lopts, uris);
+    runtime::MonitorLoop loop(feed, verdicts, stats_sink, lopts);
+    std::vector<std::unique_ptr<transport::Source>> owned;
+    std::vector<transport::Source*> sources;
+    for (size_t i = 0; i < uris.size(); ++i) {
+      owned.push_back(transport::open_source(uris[i], per[i]));
+      sources.push_back(owned.back().get());
+    }
+    install_stop_signals();
+    std::fprintf(stderr, "rvc monitor: %zu propert%s on the calls of service %s (%s, %s) -> %zu output%s\n",
+                 properties.size(), properties.size() == 1 ? "y" : "ies", input.c_str(), uris[0].c_str(),
+                 uris[1].c_str(), verdicts.size(), verdicts.size() == 1 ? "" : "s");
+    runtime::Outcome outcome = loop.run(sources);
+    finish_health(outcome, loop);
+    return finish_results(outcome, loop);
+#else
+    (void)properties;
+    (void)popts;
+    (void)verdicts;
+    (void)stats_sink;
+    std::fprintf(stderr, "rvc: this rvc was built without DDS\n");
+    return kUsage;
+#endif
   }
 
   int run() {
@@ -438,9 +511,24 @@ struct MonitorCommand {
       std::fprintf(stderr, "rvc: %s\n", e.what());
       return kUsage;
     }
+    if (check.calls && typed.given() && !ends_with(typed.type, "_Event"))
+      return run_service_wire(properties, popts, verdicts, stats_sink.get());
     popts.type = typed.resolve(input_transports);
+    // --calls: the input's events are paired into calls; the properties read the calls (JSON).
+    const msg::MessageType* event_type = popts.type;
+    if (check.calls) {
+      if (!forward_property.empty()) {
+        std::fprintf(stderr, "rvc: --forward republishes the input's messages; with --calls the properties check calls\n");
+        return kUsage;
+      }
+      popts.type = nullptr;
+    }
     attach_results(input, popts, verdicts);
     runtime::Pipeline pipeline(properties, popts, [&](const engine::Verdict& v) { verdicts.put(v); });
+    std::unique_ptr<runtime::ServiceCallFeed> call_feed;
+    if (check.calls)
+      call_feed = std::make_unique<runtime::ServiceCallFeed>(pipeline, event_type, check.service_timeout,
+                                                              popts.max_reported);
     start_results({input}, properties);
 
     runtime::LoopOptions lopts = loop_options(transport::scheme_of(input) == "file");
@@ -460,7 +548,9 @@ struct MonitorCommand {
       std::fprintf(stderr, "rvc monitor: messages that keep %s true go on to %s\n", forward_property.c_str(),
                    to.c_str());
     }
-    runtime::Feed& feed = forwarder ? static_cast<runtime::Feed&>(*forwarder) : pipeline;
+    runtime::Feed& feed = forwarder   ? static_cast<runtime::Feed&>(*forwarder)
+                          : call_feed ? static_cast<runtime::Feed&>(*call_feed)
+                                      : pipeline;
     runtime::MonitorLoop loop(feed, verdicts, stats_sink.get(), lopts);
 
     auto source = transport::open_source(input, input_transports);

@@ -91,6 +91,7 @@ bool ServiceCalls::feed(std::string_view json, std::string& error) {
       return true;
     }
     call.answered = true;
+    ++counts_.responses;
     call.response_ns = t_ns;
     first_of("response", call.response);
   }

@@ -29,6 +29,7 @@ namespace rvc::io {
 struct ServiceCallCounts {
   uint64_t events = 0;       // lines read
   uint64_t requests = 0;     // calls started
+  uint64_t responses = 0;    // response events that answered a call
   uint64_t answered = 0;     // calls made with a response
   uint64_t unanswered = 0;   // calls made at their deadline
   uint64_t duplicates = 0;   // a second request or response event of a call (the other side's)

@@ -82,4 +82,24 @@ MessageType service_event_type(const std::string& package, const std::string& se
   return t;
 }
 
+MessageType with_request_header(const MessageType& type) {
+  MessageType out = type;
+  Field guid, seq;
+  guid.name = "client_guid";
+  guid.type.prim = Prim::UInt64;
+  seq.name = "sequence_number";
+  seq.type.prim = Prim::Int64;
+  // an empty message's one uint8 stays after the header, as rmw_cyclonedds writes it
+  if (out.fields.empty()) {
+    Field pad;
+    pad.name = "structure_needs_at_least_one_member";
+    pad.type.prim = Prim::UInt8;
+    out.fields.push_back(pad);
+  }
+  out.fields.insert(out.fields.begin(), {guid, seq});
+  out.fixed_bytes += 16;
+  out.source = type.source + " (with the rmw_cyclonedds request header)";
+  return out;
+}
+
 }  // namespace rvc::msg

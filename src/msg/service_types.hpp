@@ -33,4 +33,13 @@ std::string srv_part(std::string_view text, ServicePart part, const std::string&
 // request and response types, which the registry resolves.
 MessageType service_event_type(const std::string& package, const std::string& service, const std::string& source);
 
+// The wire layout of a request or reply sample on rmw_cyclonedds' rq/<svc>Request
+// and rr/<svc>Reply topics: `type` (pkg/srv/Name_Request or _Response) with two
+// leading members, uint64 client_guid and int64 sequence_number (the 16-byte
+// request header), under the same DDS type name. A reader needs these members
+// in its descriptor: CycloneDDS checks each received sample against the
+// reader's ops and drops one whose header bytes are no valid first field
+// (docs/services.md). Nested types stay those of `type` (it must outlive this).
+MessageType with_request_header(const MessageType& type);
+
 }  // namespace rvc::msg

@@ -251,3 +251,101 @@ def test_calls_agree_with_the_stated_rule_on_random_traces(rvc):
             assert round(g["latency"] * 1e9) == lat, (trial, events, g)
         times = [g["time"] for g in got]
         assert all(b > a for a, b in zip(times, times[1:])) and all(g["time"] >= g["request_time"] for g in got)
+
+
+def hand_trace_with_extras():
+    """The trace of test_calls_pair_requests_and_responses_into_verdicts plus one event of each kind that
+    makes no call: the server's duplicate response, a response to no request, a line that is no event,
+    and a last request still within its timeout when the input ends."""
+    ok = {"success": True, "message": ""}
+    return [
+        event_line(0, 1000, 1, 1, {"data": True}),
+        event_line(0, 1010, 2, 1, {"data": False}),
+        event_line(3, 1040, 2, 1, None, ok),
+        event_line(3, 1080, 1, 1, None, ok),
+        event_line(2, 1079, 1, 1, None, ok),                  # duplicate: the server's side of call (1, 1)
+        event_line(3, 1500, 7, 9, None, ok),                  # orphan: no request seen
+        '{"data": 1}',                                        # rejected: no service event
+        event_line(0, 2000, 1, 2, {"data": True}),
+        event_line(3, 2300, 1, 2, None, ok),
+        event_line(0, 3000, 1, 3, {"data": True}),
+        event_line(3, 3050, 1, 3, None, {"success": False, "message": "no"}),
+        event_line(0, 4000, 1, 4, {"data": True}),            # never answered
+        event_line(0, 5000, 1, 5, {"data": True}),
+        event_line(3, 5020, 1, 5, None, ok),
+        event_line(0, 5100, 1, 6, {"data": True}),            # pending: the input ends within its timeout
+    ]
+
+
+def test_monitor_calls_agrees_with_the_calls_pipe_and_counts_every_event(rvc, tmp_path):
+    trace = tmp_path / "events.jsonl"
+    trace.write_text("\n".join(hand_trace_with_extras()) + "\n")
+    spec = "{answered} and {latency <= 0.1} and {response.success}"
+    piped = run([rvc, "calls", "--service-timeout", "0.5", str(trace)])
+    want = run([rvc, "check", "--all", "--spec", spec, "-"], stdin=piped.stdout)
+    r = run([rvc, "monitor", "--input", f"file:{trace}", "--calls", "--service-timeout", "0.5", "--all",
+             "--spec", spec])
+    got = [json.loads(l)["value"] for l in r.stdout.splitlines()]
+    assert got == [json.loads(l)["value"] for l in want.stdout.splitlines()]
+    assert got == [True, True, False, False, False, True]  # hand-computed, as the pipe test's
+    # violated (1) wins over the rejected line (3), as in the pipe's check
+    assert r.returncode == 1 == want.returncode, r.stderr
+    counters = json.loads([l for l in r.stderr.splitlines() if l.startswith("{")][-1])
+    # 15 events = 11 paired into 6 calls (5 answered: 2 events each, 1 unanswered) + 1 rejected
+    #   + dropped: 1 duplicate, 1 orphan, 1 pending
+    assert counters["received"] == 15 and counters["checked"] == 6 and counters["rejected"] == 1
+    assert counters["dropped"] == {"duplicate": 1, "orphan": 1, "pending": 1}
+    assert counters["calls"] == {"events": 15, "paired": 11, "calls": 6, "answered": 5, "unanswered": 1,
+                                 "pending_calls": 1}
+    assert "line 7" not in r.stderr and "service event 7: no field 'info'" in r.stderr
+
+
+def test_monitor_calls_settles_a_late_request_by_a_later_events_stamp(rvc, tmp_path):
+    # Hand-computed, timeout 0.2 s: call 1 unanswered (its deadline 1.2 passes at the 2.0 event), call 2 answered.
+    trace = tmp_path / "events.jsonl"
+    trace.write_text("\n".join([event_line(0, 1000, 1, 1, {"data": True}), event_line(0, 2000, 1, 2, {"data": True}),
+                                event_line(3, 2010, 1, 2, None, {"success": True, "message": ""})]) + "\n")
+    r = run([rvc, "monitor", "--input", f"file:{trace}", "--calls", "--service-timeout", "0.2", "--all", "--dense",
+             "--spec", "{answered}"], check=1)
+    # dense: false from 0 (the timeline's start) and at call 1; true from call 2; the file's end ticks at the
+    # events' clock, 2.01 (the pipe's check ends at its last call, 2.0)
+    assert [(json.loads(l)["time"], json.loads(l)["value"]) for l in r.stdout.splitlines()] == [
+        (0, False), (1, False), (2, True), (2.01, True)]
+
+
+@pytest.mark.needs_rust
+@pytest.mark.parametrize("topic", ["/test_service1/_service_event", "/test_service2/_service_event"])
+@pytest.mark.parametrize("dense", [False, True])
+def test_check_calls_on_the_bag_agrees_with_the_calls_pipe(rvc, tmp_path, topic, dense):
+    events = bag_events()
+    (tmp_path / "test_msgs" / "srv").mkdir(parents=True)
+    (tmp_path / "test_msgs" / "srv" / "BasicTypes.srv").write_text(events[0][1])
+    raws = [raw for t, _, raw in events if t == topic]
+    decoded = run([rvc, "msg", "decode", "--type", EVENT, "--msg-path", str(tmp_path)],
+                  stdin="".join(r.hex() + "\n" for r in raws), check=0).stdout
+    calls = run([rvc, "calls"], stdin=decoded, check=0).stdout
+    lat = sorted(json.loads(l)["latency"] for l in calls.splitlines())
+    # a bound between the two latencies: one call holds, the other not
+    spec = f"{{answered}} and {{latency <= {(lat[0] + lat[-1]) / 2!r}}}"
+    extra = ["--dense"] if dense else []
+    want = run([rvc, "check", "--all", "--spec", spec, *extra, "-"], stdin=calls)
+    got = run([rvc, "check", str(SERVICE_BAG), "--topic", topic, "--calls", "--all", "--stats", "--spec", spec,
+               *extra])
+    # dense: the bag's clock also ticks at the recording's end (one verdict more, the last call's value held)
+    assert got.stdout.startswith(want.stdout) and want.stdout.count("\n") >= 1
+    extra = got.stdout[len(want.stdout):].splitlines()
+    assert extra == [] if not dense else len(extra) <= 1
+    assert all(json.loads(l)["value"] == json.loads(want.stdout.splitlines()[-1])["value"] for l in extra)
+    assert got.returncode == want.returncode, got.stderr
+    counters = json.loads([l for l in got.stderr.splitlines() if l.startswith("{")][-1])
+    assert counters["received"] == len(raws) and counters["checked"] == len(calls.splitlines())
+    assert counters["calls"]["paired"] + counters["rejected"] == len(raws) and counters["dropped"] == {}
+
+
+def test_calls_flag_usage_errors(rvc, tmp_path):
+    trace = tmp_path / "t.jsonl"
+    trace.write_text(event_line(0, 1000, 1, 1) + "\n")
+    r = run([rvc, "check", "--calls", "--spec", "{answered}", str(trace)], check=2)
+    assert "rvc calls" in r.stderr
+    r = run([rvc, "monitor", "--calls", "--input", "a=file:x", "--input", "b=file:y", "--spec", "{a.x}"], check=2)
+    assert "one --input" in r.stderr
