@@ -15,7 +15,8 @@
 # compiled dependencies survive between builds of the same tree; cargo's
 # parallelism follows RVC_CARGO_JOBS (default 2, the size of our machines).
 #
-# A shared target dir is claimed by the checkout that builds (CargoClaim.cmake),
+# A shared target dir is claimed by the checkout that builds (CargoClaim.cmake)
+# and the library copied into the build tree, under one lock (CargoBuild.cmake),
 # so one checkout never links a library cargo built from another's sources.
 #
 # Ninja reruns cargo only when a file under src/, Cargo.toml or Cargo.lock
@@ -66,7 +67,8 @@ function(rvc_cargo_staticlib target)
   if(NOT target_dir)
     set(target_dir "${CMAKE_BINARY_DIR}/cargo-target")
   endif()
-  set(lib "${target_dir}/release/lib${ARG_LIB_NAME}.a")
+  # The build tree links its own copy (CargoBuild.cmake says why).
+  set(lib "${CMAKE_CURRENT_BINARY_DIR}/lib${ARG_LIB_NAME}.a")
   set(stamp "${CMAKE_CURRENT_BINARY_DIR}/${target}.cargo-stamp")
 
   # The [package] name, for CargoClaim.cmake (the first `name =` line).
@@ -76,17 +78,18 @@ function(rvc_cargo_staticlib target)
   file(GLOB_RECURSE sources CONFIGURE_DEPENDS
     "${manifest_dir}/src/*.rs" "${manifest_dir}/build.rs")
 
+  find_program(FLOCK_EXECUTABLE flock REQUIRED DOC "flock (util-linux): one cargo build per shared target dir at a time")
+  file(MAKE_DIRECTORY "${target_dir}")
   add_custom_command(
     OUTPUT "${stamp}"
     BYPRODUCTS "${lib}"
-    COMMAND "${CMAKE_COMMAND}" "-DTARGET_DIR=${target_dir}" "-DMANIFEST_DIR=${manifest_dir}"
-            "-DPACKAGE=${package}" -P "${PROJECT_SOURCE_DIR}/cmake/CargoClaim.cmake"
-    COMMAND "${CMAKE_COMMAND}" -E env
-            "CARGO_TARGET_DIR=${target_dir}" "CARGO_BUILD_JOBS=${RVC_CARGO_JOBS}"
-            "${CARGO_EXECUTABLE}" build --locked --release -j ${RVC_CARGO_JOBS}
-            --manifest-path "${manifest_dir}/Cargo.toml"
+    COMMAND "${FLOCK_EXECUTABLE}" "${target_dir}/.rvc-build.lock"
+            "${CMAKE_COMMAND}" "-DTARGET_DIR=${target_dir}" "-DMANIFEST_DIR=${manifest_dir}"
+            "-DPACKAGE=${package}" "-DCARGO=${CARGO_EXECUTABLE}" "-DJOBS=${RVC_CARGO_JOBS}"
+            "-DLIB_NAME=${ARG_LIB_NAME}" "-DCOPY_TO=${lib}" -P "${PROJECT_SOURCE_DIR}/cmake/CargoBuild.cmake"
     COMMAND "${CMAKE_COMMAND}" -E touch "${stamp}"
     DEPENDS ${sources} "${manifest_dir}/Cargo.toml" "${manifest_dir}/Cargo.lock"
+            "${PROJECT_SOURCE_DIR}/cmake/CargoBuild.cmake" "${PROJECT_SOURCE_DIR}/cmake/CargoClaim.cmake"
     WORKING_DIRECTORY "${manifest_dir}"
     COMMENT "cargo build --release ${ARG_LIB_NAME}"
     VERBATIM)

@@ -36,6 +36,10 @@ void CheckOptions::add_to(CLI::App& app) {
       ->group("");  // hidden: for bench/, not for users
   app.add_flag("--no-layouts", no_layouts, "Parse every message with simdjson (no layout fast path)")
       ->group("");  // hidden: for bench/ and for comparing the two paths
+  app.add_flag("--plain-eval", plain_eval,
+               "Evaluate every field test and step every operator at every message (no threshold index, no "
+               "change-driven stepping)")
+      ->group("");  // hidden: for bench/ and the differential tests of the two paths
 }
 
 std::vector<engine::PropertySpec> CheckOptions::properties() const {
@@ -63,6 +67,7 @@ PipelineOptions CheckOptions::pipeline_options() const {
   o.max_reported = max_reported;
   o.parse_only = parse_only;
   o.layouts = !no_layouts;
+  o.incremental = !plain_eval;
   o.robustness = robustness;
   o.explain = explain;
   o.max_data_values = max_data_values;

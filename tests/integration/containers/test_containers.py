@@ -51,8 +51,7 @@ def host_zenoh_lib():
     lib = os.environ.get("RVC_ZENOH_LIB")  # set by tests/CMakeLists.txt: where this build put it
     if lib:
         return lib if os.path.isfile(lib) else None
-    target = os.environ.get("RVC_CARGO_TARGET_DIR") or os.path.join(os.path.dirname(os.environ["RVC_BIN"]), "cargo-target")
-    lib = os.path.join(target, "release", "librvc_zenoh.a")
+    lib = os.path.join(os.path.dirname(os.environ["RVC_BIN"]), "src", "transport", "zenoh", "librvc_zenoh.a")
     return lib if os.path.isfile(lib) else None
 
 
