@@ -145,7 +145,7 @@ std::string message(Rng& rng, double t, double& walk, bool json_only) {
   return j;
 }
 
-struct Run {
+struct Outcome {
   std::vector<std::string> verdicts;
   runtime::PipelineStats stats;
 };
@@ -154,7 +154,7 @@ struct Config {
   bool dense, robustness, all, explain, typed, incremental;
 };
 
-Run run(const std::vector<engine::PropertySpec>& props, const std::vector<std::string>& jsons, const Config& c,
+Outcome run(const std::vector<engine::PropertySpec>& props, const std::vector<std::string>& jsons, const Config& c,
         const msg::MessageType* type) {
   runtime::PipelineOptions o;
   o.model = c.dense ? engine::TimeModel::Dense : engine::TimeModel::Discrete;
@@ -165,7 +165,7 @@ Run run(const std::vector<engine::PropertySpec>& props, const std::vector<std::s
   o.max_reported = 0;
   o.incremental = c.incremental;
   if (c.typed) o.type = type;
-  Run r;
+  Outcome r;
   runtime::Pipeline p(props, o, [&](const engine::Verdict& v) {
     std::string s = v.property + "@" + number(v.time) + (v.value ? "T" : "F");
     if (v.robust) s += " r=" + number(v.robustness);
@@ -188,7 +188,7 @@ Run run(const std::vector<engine::PropertySpec>& props, const std::vector<std::s
   return r;
 }
 
-std::string first_difference(const Run& a, const Run& b) {
+std::string first_difference(const Outcome& a, const Outcome& b) {
   for (size_t i = 0; i < std::min(a.verdicts.size(), b.verdicts.size()); ++i)
     if (a.verdicts[i] != b.verdicts[i]) return "verdict " + std::to_string(i) + ": " + a.verdicts[i] + " vs " + b.verdicts[i];
   return "counts " + std::to_string(a.verdicts.size()) + " vs " + std::to_string(b.verdicts.size());
@@ -208,7 +208,7 @@ TEST(Incremental, SameVerdictsAsThePlainPath) {
     for (int m = 0; m < 300; ++m) jsons.push_back(message(rng, 0.5 * m + 0.25 * pick(rng, 2), walk, !c.typed));
     Config plain = c;
     plain.incremental = false;
-    const Run fast = run(props, jsons, c, types.type), slow = run(props, jsons, plain, types.type);
+    const Outcome fast = run(props, jsons, c, types.type), slow = run(props, jsons, plain, types.type);
     ASSERT_GT(slow.verdicts.size(), props.size()) << "seed " << seed;
     EXPECT_EQ(fast.verdicts, slow.verdicts) << "seed " << seed << " dense " << c.dense << " robust " << c.robustness
                                             << " all " << c.all << " explain " << c.explain << " typed " << c.typed
