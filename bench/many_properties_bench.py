@@ -140,7 +140,8 @@ def main():
         f"\n\n{a.messages:,} messages (p, q, r Booleans; {trace_text}), `rvc check -o /dev/null`, CPU time (user + sys) "
         f"per message with the start-up (a run on the first message) taken off, best of {a.reps}; `--plain-eval` on "
         f"at most {a.plain_budget:,.0f} property-messages. Load average {load[0]:.1f} before, {load_after[0]:.1f} after "
-        "(2 cores, shared). Reproduce: `python3 bench/many_properties_bench.py`.\n")
+        "(2 cores, shared). Reproduce: `python3 bench/many_properties_bench.py"
+        + "".join(" " + x for x in sys.argv[1:] if x != "--no-docs") + "`.\n")
     print(text)
     out_dir = os.path.join(ROOT, "bench", "results")
     os.makedirs(out_dir, exist_ok=True)
