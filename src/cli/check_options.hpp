@@ -24,6 +24,7 @@ struct CheckOptions {
   size_t max_reported = 100;
   bool parse_only = false;
   bool no_layouts = false;
+  bool plain_eval = false;
   bool robustness = false;
   bool explain = false;
   uint32_t max_data_values = 100000;

@@ -61,6 +61,13 @@ class Checker {
   void set_max_data_values(uint32_t n) { max_data_values_ = n; }
   bool has_data_references() const { return !data_.empty() || !dense_data_.empty(); }
 
+  // Change-driven stepping (on by default): discrete Boolean properties
+  // without data references step only the operators whose operands changed
+  // (discrete::Monitor::step_changed), and only properties whose value may
+  // have changed are looked at. Verdicts are the same either way; off
+  // (--plain-eval) steps everything, to compare.
+  void set_incremental(bool on) { incremental_ = on; }
+
   // Parses and compiles; throws spec::SpecError naming the column.
   void add_property(const PropertySpec& property);
 
@@ -118,6 +125,8 @@ class Checker {
   void report_robust(size_t property, double time, double robustness);
   // Each property's value at the clock, the held values (tick, next_deadline).
   bool value_at_clock(size_t property, const uint8_t* atoms, const uint32_t* bound);
+  void step_changes(const uint8_t* atoms);
+  void report_discrete(size_t property, double now);
 
   TimeModel model_;
   bool emit_all_;
@@ -148,6 +157,14 @@ class Checker {
   // With emit_all, the step that starts there does not report it again.
   double told_at_ = std::numeric_limits<double>::quiet_NaN();
   std::vector<int8_t> last_;  // last reported value per property, -1 before the first
+  // Change-driven stepping: the atoms of the previous step, the atoms that
+  // differ now, the properties whose root changed, and per monitor its
+  // properties' indices.
+  bool incremental_ = true;
+  bool started_ = false;
+  std::vector<uint8_t> previous_atoms_;
+  std::vector<uint32_t> changed_atoms_, changed_roots_, changed_properties_;
+  std::vector<std::vector<uint32_t>> property_of_;
   uint64_t violations_ = 0;
 };
 

@@ -1,6 +1,7 @@
 #include "io/cdr_decoder.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 #include "io/cdr_cursor.hpp"
@@ -86,6 +87,19 @@ CdrDecoder::CdrDecoder(const engine::AtomTable& atoms, const MessageType& type, 
     if (tests[id].op == FOp::Bind && bound_.empty()) bound_.assign(tests.size(), 0), next_bound_ = bound_;
   }
   if (options_.need_time) plan_time(options_.time_field);
+  index_thresholds(root_);
+}
+
+void CdrDecoder::index_thresholds(Plan& plan) {
+  for (FieldPlan& f : plan.fields) index_thresholds(f);
+}
+
+void CdrDecoder::index_thresholds(FieldPlan& f) {
+  // Robustness wants every test's margin: no index then.
+  if (options_.threshold_index && !options_.robustness) f.thresholds.build(f.tests, atoms_.tests(), f.rest);
+  if (f.below) index_thresholds(*f.below);
+  for (auto& e : f.elements)
+    if (e) index_thresholds(*e);
 }
 
 CdrDecoder::~CdrDecoder() = default;
@@ -299,7 +313,12 @@ bool CdrDecoder::tested_field(CdrCursor& in, const FieldPlan& f) {
 }
 
 bool CdrDecoder::apply(const FieldPlan& f, const FieldValue& v) {
-  for (int id : f.tests) {
+  const std::vector<int>* ids = &f.tests;
+  if (!f.thresholds.empty() && v.kind == ValueKind::Number && std::fabs(v.d) < spec::kTwo53) {
+    f.thresholds.apply(v.d, next_.data());  // the grouped comparisons; the loop does the others
+    ids = &f.rest;
+  }
+  for (int id : *ids) {
     const spec::FieldTest& t = atoms_.tests()[id];
     const int result = evaluate_test(t, v);
     if (result >= 0) {

@@ -25,6 +25,7 @@
 #include "io/cdr_codec.hpp"
 #include "io/field_tests.hpp"
 #include "io/json_decoder.hpp"
+#include "io/threshold_index.hpp"
 #include "msg/msg_types.hpp"
 
 namespace rvc::io {
@@ -76,6 +77,10 @@ class CdrDecoder {
     std::unique_ptr<Plan> below;        // a nested message with tested (or time) fields inside
     std::vector<std::unique_ptr<FieldPlan>> elements;  // tested elements by index ({ranges[0]}), else null
     TimeRole time = TimeRole::None;
+    // Comparisons with many constants, evaluated together for a number
+    // (DecoderOptions::threshold_index); rest: the other tests.
+    ThresholdIndex thresholds;
+    std::vector<int> rest;
   };
   struct Plan {
     const msg::MessageType* type = nullptr;
@@ -90,6 +95,8 @@ class CdrDecoder {
   bool planned_value(CdrCursor& in, const FieldPlan& f);
   static std::unique_ptr<Plan> plan_of(const msg::MessageType& type);
   bool apply(const FieldPlan& f, const FieldValue& value);
+  void index_thresholds(Plan& plan);
+  void index_thresholds(FieldPlan& f);
   static bool skip(CdrCursor& in, const msg::FieldType& t);
   static bool skip_element(CdrCursor& in, const msg::FieldType& t);
   static bool skip_message(CdrCursor& in, const msg::MessageType& type);

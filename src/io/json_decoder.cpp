@@ -216,6 +216,9 @@ void JsonDecoder::prepare(KeyNode& node) {
     }
   }
   node.kind = all_bool ? Kind::Bool : all_number ? Kind::Number : Kind::General;
+  node.number_rest = node.tests;
+  if (node.kind == Kind::Number && options_.threshold_index)
+    node.thresholds.build(node.tests, atoms_.tests(), node.number_rest);
 }
 
 // Returns false when the value is not of the expected type: the caller then

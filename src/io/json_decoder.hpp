@@ -18,6 +18,7 @@
 #include "engine/atom_table.hpp"
 #include "io/bound_values.hpp"
 #include "io/json_layout.hpp"
+#include "io/threshold_index.hpp"
 
 namespace rvc::io {
 
@@ -29,6 +30,9 @@ struct DecoderOptions {
   // Read lines laid out like earlier ones by position (JsonLayout) instead of
   // parsing them. Off only to compare the two paths (tests, fuzzing).
   bool layouts = true;
+  // Evaluate a field's comparisons with many constants together (io/threshold_index.hpp)
+  // and write only the atoms that change. Off only to compare with the plain per-test loop.
+  bool threshold_index = true;
 };
 
 class JsonDecoder {
@@ -107,6 +111,10 @@ class JsonDecoder {
     std::vector<Seen> by_position;
     Kind kind = Kind::General;
     std::vector<BoolTest> bool_tests;
+    // A Number field's comparisons with many constants, evaluated together;
+    // number_rest: its other tests (all of them without an index).
+    ThresholdIndex thresholds;
+    std::vector<int> number_rest;
     uint32_t seen = 0;               // message generation when last present (strict mode)
     bool is_index = false;           // an array element: name "[N]"
     std::vector<KeyNode*> by_index;  // the element children by index (null: not tested)
@@ -193,7 +201,8 @@ inline void JsonDecoder::bool_tests(const KeyNode& node, bool b) {
 // is on the same side of d as its rounded double); from 2^53 up (nanosecond
 // stamps, 64-bit ids) number_tests_exact compares the exact value.
 inline void JsonDecoder::number_tests(const KeyNode& node, double d) {
-  for (int id : node.tests) {
+  if (!node.thresholds.empty()) node.thresholds.apply(d, next_.data());
+  for (int id : node.number_rest) {
     const spec::FieldTest& t = atoms_.tests()[id];
     const double x = t.value.number;
     uint8_t r = 1;

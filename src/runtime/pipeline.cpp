@@ -43,6 +43,7 @@ void check_unnamed(const std::vector<engine::PropertySpec>& properties, const Pi
 engine::Checker build(const std::vector<engine::PropertySpec>& properties, const PipelineOptions& options,
                       engine::VerdictCallback on_verdict) {
   engine::Checker checker(options.model, options.emit_all, std::move(on_verdict));
+  checker.set_incremental(options.incremental);
   if (options.robustness) checker.enable_robustness();
   if (options.explain) checker.enable_explain();
   checker.set_max_data_values(options.max_data_values);
@@ -95,7 +96,8 @@ Pipeline::Pipeline(const std::vector<engine::PropertySpec>& properties, const Pi
       options_(with_defaults(options)),
       atoms_(checker_.atoms()),
       decoder_(atoms_, io::DecoderOptions{options.model == engine::TimeModel::Dense, options.time_field,
-                                          options.strict, needs_margins(options, timed_.get()), options.layouts}),
+                                          options.strict, needs_margins(options, timed_.get()), options.layouts,
+                                          options.incremental}),
       batch_reader_(*this, options.max_message_size) {
   make_typed_decoder();
   if (timed_) {
@@ -117,7 +119,7 @@ void Pipeline::make_typed_decoder() {
   if (!options_.type) return;
   typed_.emplace(atoms_, *options_.type,
                  io::DecoderOptions{options_.model == engine::TimeModel::Dense, options_.time_field, options_.strict,
-                                    needs_margins(options_, timed_.get())});
+                                    needs_margins(options_, timed_.get()), true, options_.incremental});
 }
 
 Pipeline::Pipeline(const engine::AtomTable& atoms, const PipelineOptions& options, MessageHook hook)
@@ -126,7 +128,7 @@ Pipeline::Pipeline(const engine::AtomTable& atoms, const PipelineOptions& option
       atoms_(atoms),
       hook_(std::move(hook)),
       decoder_(atoms_, io::DecoderOptions{options.model == engine::TimeModel::Dense, options.time_field,
-                                          options.strict, options.robustness, options.layouts}),
+                                          options.strict, options.robustness, options.layouts, options.incremental}),
       batch_reader_(*this, options.max_message_size) {
   make_typed_decoder();
 }

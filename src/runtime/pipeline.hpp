@@ -38,6 +38,11 @@ struct PipelineOptions {
   uint32_t max_data_values = 100000;   // data references: distinct values per variable
   size_t max_message_size = 1 << 20;   // longest message: a line, a payload, a line inside a batched payload
   bool layouts = true;                 // read lines laid out like earlier ones by position (io/json_layout.hpp)
+  // Evaluate comparisons of one field with many constants together and step
+  // only the operators whose inputs changed (io/threshold_index.hpp,
+  // engine/discrete/monitor.hpp). Off (hidden --plain-eval): every test and
+  // operator at every message, to compare the two paths.
+  bool incremental = true;
   // Typed input (--type): each payload is one CDR sample of this type,
   // decoded straight into the tests' values (properties are checked against
   // the type first). Owned by the caller's msg::TypeRegistry; null: JSON.

@@ -126,6 +126,7 @@ SyncedPipeline::SyncedPipeline(const std::vector<engine::PropertySpec>& properti
       options_(options),
       sync_(sync),
       on_set_(std::move(on_set)) {
+  checker_.set_incremental(options.incremental);
   if (inputs.empty()) throw std::invalid_argument("no inputs to synchronize");
   if (options.robustness)
     throw std::invalid_argument("--robustness checks one input for now (not several synchronized ones)");

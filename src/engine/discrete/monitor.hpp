@@ -37,6 +37,31 @@ class Monitor {
   Step now() const { return now_; }  // index of the next step
   size_t operators() const { return ops_.size(); }  // after sharing (benchmarks, tests)
 
+  // ---- Change-driven stepping (Checker's default; the plain step() above is
+  // kept for --plain-eval and the differential tests) ----
+  //
+  // step_changed() gives the same values as step(), evaluating only the
+  // operators whose operands changed since the previous step, plus the
+  // bounded ones (and pre) whose state can still change with unchanged
+  // operands. Skipping any other operator is exact: connectives and the
+  // unbounded latches are idempotent under repeated operands (once: last | a
+  // is last again), and a bounded operator with an empty window and an input
+  // that adds nothing (once[a:b] of false, since with false right side) does
+  // nothing when stepped. A window whose front covers the rest of time
+  // (once[3:] after its input held) is as stable. Every slot therefore holds
+  // the value step() would have given (explain() reads them), except, with
+  // prune_dead, inside dead cones: an unbounded historically that has fallen
+  // false (once that has risen true) never changes again, so the operators
+  // only it reads are never stepped again, nor is it.
+  //
+  // `changed`: the atom table ids whose values differ from the previous
+  // step's (ignored at the first step, which steps everything). Appends to
+  // `roots` the properties whose root slot changed (all at the first step).
+  void set_prune_dead(bool on) { prune_dead_ = on; }
+  void step_changed(const uint8_t* atoms, const uint32_t* changed, size_t n_changed, std::vector<uint32_t>& roots);
+  // Operators stepped by the last step_changed (benchmarks, tests).
+  size_t stepped() const { return stepped_; }
+
   // After step(): why property k has its current value, as sentences naming
   // sub-formulas and steps ("{x > 3} is false at step 12"). For --explain, at
   // a violation: it reads this step's values, so it costs nothing before.
@@ -86,6 +111,30 @@ class Monitor {
   std::vector<Historically> historically_;
   std::vector<Since> since_;
   Step now_ = 0;
+
+  // Change-driven stepping (built at the first step_changed).
+  void prepare_changes();
+  uint8_t evaluate(const Op& op, uint8_t* v, Step now);
+  bool quiet(const Op& op, const uint8_t* v, Step now) const;  // skipping it next step is exact
+  bool frozen_value(const Op& op, uint8_t r) const;         // an unbounded latch that can no longer change
+  void release(uint32_t op);                                 // op no longer read: its operands may die
+  void mark_readers(uint16_t slot, std::vector<uint32_t>& roots);
+  bool prune_dead_ = false;
+  bool prepared_ = false;
+  static constexpr uint16_t kNoSlot = 0xFFFF;
+  std::vector<uint16_t> slot_of_atom_;      // atom table id -> this monitor's slot (kNoSlot: not read)
+  std::vector<uint32_t> reader_begin_, readers_;  // per slot: the ops reading it (CSR)
+  std::vector<uint32_t> root_begin_, roots_;      // per slot: the properties whose root it is (CSR)
+  std::vector<uint32_t> op_of_slot_;        // an op's output slot -> the op (UINT32_MAX: atom, constant)
+  std::vector<uint32_t> live_readers_;      // prune_dead: readers still stepped + properties rooted there
+  std::vector<uint8_t> skip_;               // 1: dead or frozen, never stepped again
+  std::vector<uint64_t> dirty_, dirty_words_;  // ops to step (bitset) and its non-empty words (bitset)
+  std::vector<uint32_t> busy_, next_busy_;  // bounded ops and pre that are not quiet: stepped next step too
+  size_t stepped_ = 0;
+  void mark(uint32_t op) {
+    dirty_[op >> 6] |= uint64_t{1} << (op & 63);
+    dirty_words_[op >> 12] |= uint64_t{1} << ((op >> 6) & 63);
+  }
 };
 
 }  // namespace rvc::engine::discrete
