@@ -339,6 +339,12 @@ void MonitorLoop::process(const std::vector<transport::Source*>& sources) {
   Shutdown shutdown(queue, started);
   for (size_t i = 0; i < started.size(); ++i) {
     const auto input = ros_clock && i == sources.size() ? kRosClockInput : static_cast<uint32_t>(i);
+    // A source that never blocks its transport thread fills the queue by
+    // itself (DDS); the others push, blocking while it is full.
+    if (auto* feeder = dynamic_cast<transport::QueueFeeder*>(started[i])) {
+      feeder->start_into(queue, input);
+      continue;
+    }
     started[i]->start([&queue, input](const transport::Frame& f) {
       transport::Frame tagged = f;
       tagged.input = input;
