@@ -84,6 +84,18 @@ class FrameQueue {
     if (waiter && std::find(waiters_.begin(), waiters_.end(), waiter) == waiters_.end()) waiters_.push_back(waiter);
     return 0;
   }
+  // Producer side, never blocking: `waiter` has frames to give (a DDS
+  // listener on the receive thread, which does no more than this): its
+  // on_room() is called on the consumer's thread at the next pop, waking the
+  // consumer if it sleeps. The consumer then takes them (the copy and the
+  // transport's take run there, not on the transport's thread).
+  void request(RoomWaiter* waiter) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    if (closed_) return;
+    if (std::find(waiters_.begin(), waiters_.end(), waiter) == waiters_.end()) waiters_.push_back(waiter);
+    pending_.fetch_add(1, std::memory_order_relaxed);
+    wake(lock);
+  }
   // Appends without waiting (what room() granted). Dropped only once closed.
   void push_nowait(const Frame& frame) {
     std::unique_lock<std::mutex> lock(mutex_);
@@ -103,15 +115,17 @@ class FrameQueue {
   bool pop_batch_until(std::vector<OwnedFrame>& batch, size_t& count, std::chrono::steady_clock::time_point until) {
     if (pending_.load(std::memory_order_relaxed) == 0) poll(until);
     std::unique_lock<std::mutex> lock(mutex_);
+    call_waiters(lock);  // those that asked to give frames: they fill the queue now
     if (incoming_count_ == 0 && !closed_) {
       sleeping_ = true;
       signalled_ = false;
       not_empty_.wait_until(lock, until, [&] {
-        if (incoming_count_ > 0 || closed_) return true;
+        if (incoming_count_ > 0 || closed_ || !waiters_.empty()) return true;
         signalled_ = false;  // a spurious wake-up: the next push signals again
         return false;
       });
       sleeping_ = false;
+      call_waiters(lock);
     }
     count = incoming_count_;
     if (count == 0) return !closed_;
@@ -120,12 +134,9 @@ class FrameQueue {
     incoming_count_ = 0;
     pending_.store(0, std::memory_order_relaxed);
     not_full_.notify_all();
-    asking_.swap(waiters_);
-    lock.unlock();
     // Producers that left frames behind take them now (on this thread: the
-    // queue has room for a whole batch of theirs).
-    for (RoomWaiter* w : asking_) w->on_room();
-    asking_.clear();
+    // queue has room for a whole batch of theirs); they are the next batch.
+    call_waiters(lock);
     return true;
   }
 
@@ -153,13 +164,27 @@ class FrameQueue {
     slot.publisher = frame.publisher;
     slot.input = frame.input;
     slot.key.assign(frame.key.data(), frame.key.size());
-    pending_.store(incoming_count_, std::memory_order_relaxed);
-    // Only a sleeping consumer needs the (system call) wake-up, once.
+    pending_.fetch_add(1, std::memory_order_relaxed);
+    wake(lock);
+  }
+
+  // Only a sleeping consumer needs the (system call) wake-up, once per sleep.
+  void wake(std::unique_lock<std::mutex>& lock) {
     if (sleeping_ && !signalled_) {
       signalled_ = true;
       lock.unlock();
       not_empty_.notify_one();
     }
+  }
+
+  // Calls (without the lock) the producers waiting to give frames.
+  void call_waiters(std::unique_lock<std::mutex>& lock) {
+    if (waiters_.empty()) return;
+    asking_.swap(waiters_);
+    lock.unlock();
+    for (RoomWaiter* w : asking_) w->on_room();
+    asking_.clear();
+    lock.lock();
   }
 
   // Before sleeping: poll for up to spin_ (never past `until`), yielding
@@ -179,7 +204,7 @@ class FrameQueue {
   std::condition_variable not_full_, not_empty_;
   std::vector<OwnedFrame> incoming_;
   size_t incoming_count_ = 0;
-  std::atomic<size_t> pending_{0};  // incoming_count_, read without the lock while polling
+  std::atomic<size_t> pending_{0};  // frames and requests since the last pop, read while polling
   size_t capacity_;
   std::chrono::microseconds spin_;
   bool closed_ = false;
