@@ -9,14 +9,15 @@
 // - push(): blocks while the queue is full. Backpressure reaches the
 //   middleware, which with reliable QoS slows the publisher down. Only for
 //   threads that may block (Zenoh's callback, a source's own thread).
-// - room() + push_nowait(): for a thread that must never block (CycloneDDS's
-//   receive thread, which also carries the acknowledgements a verdict writer
-//   of the same process waits for). The producer takes from its transport
-//   only as many messages as room() grants and leaves the rest there (a
-//   keep-all reader's history); room() == 0 registers the producer, and the
-//   consumer calls its on_room() on its own thread after the next pop, where
-//   it takes the rest. Several such producers can overshoot the capacity by
-//   what room() granted each at once; never by more.
+// - request() / room() + push_nowait(): for a transport thread that must
+//   never block (CycloneDDS's receive thread, which also carries the
+//   acknowledgements a verdict writer of the same process waits for). Its
+//   listener only calls request(); the consumer then calls the producer's
+//   on_room() on its own thread, which takes from the transport only as many
+//   messages as room() grants and leaves the rest there (a keep-all
+//   reader's history); room() == 0 registers it for another on_room() after
+//   the next pop. Several such producers can overshoot the capacity by what
+//   room() granted each at once; never by more.
 //
 // Wake-ups: a producer signals the consumer only while it sleeps in
 // pop_batch_until, once per sleep. Before sleeping, the consumer polls for a
