@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <string_view>
 #include <stdexcept>
 #include <vector>
 
@@ -345,7 +347,14 @@ void MonitorLoop::process(const std::vector<transport::Source*>& sources) {
   // on this thread (the engine's) costs nothing while it sleeps.
   if (options_.clock != ClockKind::Off) ::prctl(PR_SET_TIMERSLACK, 1000UL, 0, 0, 0);
   if (feed_.reads_in_order()) return process_in_order(sources);
-  transport::FrameQueue queue(options_.queue_capacity);
+  // RVC_HANDOFF=sleep (benchmarks only: bench/network_bench.py measures the
+  // two side by side) is the hand-off as it was before 2026-11-27: the engine
+  // thread sleeps at once when the queue is empty, and a DDS source takes its
+  // samples on its own waitset thread.
+  const char* handoff = std::getenv("RVC_HANDOFF");
+  const bool legacy = handoff && std::string_view(handoff) == "sleep";
+  transport::FrameQueue queue(options_.queue_capacity,
+                              legacy ? std::chrono::microseconds(0) : transport::FrameQueue::kSpin);
   std::vector<transport::Source*> started = sources;
   const bool ros_clock = options_.clock == ClockKind::Ros && options_.ros_clock;
   if (ros_clock) {
@@ -355,6 +364,12 @@ void MonitorLoop::process(const std::vector<transport::Source*>& sources) {
   Shutdown shutdown(queue, started);
   for (size_t i = 0; i < started.size(); ++i) {
     const auto input = ros_clock && i == sources.size() ? kRosClockInput : static_cast<uint32_t>(i);
+    // A source that never blocks its transport thread fills the queue by
+    // itself (DDS); the others push, blocking while it is full.
+    if (auto* feeder = legacy ? nullptr : dynamic_cast<transport::QueueFeeder*>(started[i])) {
+      feeder->start_into(queue, input);
+      continue;
+    }
     started[i]->start([&queue, input](const transport::Frame& f) {
       transport::Frame tagged = f;
       tagged.input = input;

@@ -15,6 +15,7 @@
 
 #include "transport/dds/dds_options.hpp"
 #include "transport/endpoint.hpp"
+#include "transport/frame_queue.hpp"
 
 namespace rvc::transport {
 
@@ -29,7 +30,7 @@ namespace rvc::transport {
 //   marker  -> Frame{"", seq, eos=true}   seq: the writer's last seq (Frame
 //              type) or the number of samples it wrote (String type), so that
 //              SeqCounters::on_eos turns "sent but never received" into gaps
-class DdsSource final : public Source {
+class DdsSource final : public Source, public QueueFeeder {
  public:
   DdsSource(std::string topic, DdsOptions opts);
   ~DdsSource() override;
@@ -37,6 +38,9 @@ class DdsSource final : public Source {
   DdsSource& operator=(const DdsSource&) = delete;
 
   void start(FrameHandler handler) override;
+  // The monitor's path: a listener on CycloneDDS's receive thread that never
+  // blocks it (see the .cpp and FrameQueue::room).
+  void start_into(FrameQueue& queue, uint32_t input) override;  // QueueFeeder
   void stop() override;
 
   // Waits until at least n writers match this reader; false on timeout.
@@ -47,6 +51,7 @@ class DdsSource final : public Source {
   const std::string& dds_topic() const;
 
  private:
+  void listen();  // sets the data listener and takes what arrived before
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

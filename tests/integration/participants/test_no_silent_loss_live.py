@@ -127,3 +127,31 @@ def test_two_topics_merged(rvc, tmp_path, transport, seed, late):
         assert stats["dropped"] == {}, err
     elif stats["dropped"]:
         assert "dropped as late" in err and "dropped, not checked" in err, err
+
+
+def test_dds_full_queue_with_verdicts_on_dds(rvc, tmp_path, transport):
+    """The monitor takes DDS samples on CycloneDDS's receive thread and must never block it: with a
+    two-message engine queue (full nearly all the time) and its verdict writer on DDS in the same
+    process, whose acknowledgements arrive on that very thread, every message is still received,
+    checked and answered by a verdict (the replay counts them back), none lost or doubled."""
+    if transport != "dds":
+        pytest.skip("the receive-thread hand-off is DDS's")
+    n = 3000
+    trace = write(tmp_path / "t.jsonl", [json.dumps({"time": i, "x": i % 5}) for i in range(n)])
+    net = Net("dds")
+    verdicts = "dds:/rvc_test/verdicts"
+    mon = subprocess.Popen([rvc, "monitor", "--all", "--spec", "{x >= 0}", "--input", net.topic, "--output", verdicts,
+                            "--queue", "2", "--exit-on-eos", *net.monitor_flags],
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    rep = subprocess.run([rvc, "replay", trace, "--to", net.topic, "--rate", "max", "--latency-from", verdicts,
+                          "--wait-timeout", "20", *net.replay_flags], capture_output=True, text=True,
+                         timeout=HANG_GUARD)
+    _, err = mon.communicate(timeout=HANG_GUARD)
+    assert rep.returncode == 0, rep.stderr
+    stats = json.loads([line for line in err.splitlines() if line.startswith("{")][-1])
+    sent = json.loads(rep.stdout.strip().splitlines()[-1])
+    assert mon.returncode == 0, err
+    assert sent["sent"] == n
+    assert (stats["received"], stats["checked"], stats["rejected"], stats["dropped"]) == (n, n, 0, {}), err
+    assert stats["gaps"] == 0 and stats["duplicates"] == 0, err
+    assert stats["verdicts"] == n and sent["verdicts_back"] == n, (err, rep.stdout)
