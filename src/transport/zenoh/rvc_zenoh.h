@@ -141,7 +141,7 @@ int rvc_zenoh_token_undeclare(rvc_zenoh_token* t);
 /* Called once per live token, on the calling thread; key borrowed for the call. */
 typedef void (*rvc_zenoh_key_cb)(const uint8_t* key, size_t key_len, void* ctx);
 /* The liveliness tokens alive now whose key matches keyexpr (e.g. rmw_zenoh's
- * graph "@ros2_lv/0/**"). Blocks until every peer answered or timeout_ms ran
+ * graph of domain 0, "@ros2_lv/0/" and any key below it). Blocks until every peer answered or timeout_ms ran
  * out. Returns the number of tokens (>= 0) or a negative error code. */
 int rvc_zenoh_liveliness_get(const rvc_zenoh_session* s, const char* keyexpr, uint64_t timeout_ms,
                              rvc_zenoh_key_cb cb, void* ctx);
