@@ -176,14 +176,7 @@ void Checker::step(const uint8_t* atoms, const uint32_t* bound) {
       }
       continue;
     }
-    const discrete::Monitor& m = discrete_[where_[i].first];
-    const bool value = m.value(where_[i].second);
-    if (explain_ && !value && last_[i] != 0) {  // a violation starts: say why
-      const std::vector<std::string> why = m.explain(where_[i].second);
-      report(i, now, value, &why);
-    } else {
-      report(i, now, value);
-    }
+    report_discrete(i, now);
   }
 }
 
