@@ -16,6 +16,12 @@ PACKAGES = ["builtin_interfaces", "std_msgs", "geometry_msgs", "sensor_msgs", "n
             "rosgraph_msgs", "rcl_interfaces", "tf2_msgs", "trajectory_msgs", "visualization_msgs", "action_msgs",
             "unique_identifier_msgs", "shape_msgs", "service_msgs"]
 EMPTY = "structure_needs_at_least_one_member"
+# Default values, which rosbags' store does not keep: the published definitions' (facts, checked by
+# tests/cli/test_msg_cdr.py::test_bundled_defaults). A Quaternion with no w given is the identity.
+DEFAULTS = {
+    "geometry_msgs/msg/Quaternion": {"x": "0", "y": "0", "z": "0", "w": "1"},
+    "rcl_interfaces/msg/ParameterDescriptor": {"read_only": "false", "dynamic_typing": "false"},
+}
 OUT = pathlib.Path(__file__).resolve().parent.parent / "src" / "msg" / "definitions"
 
 
@@ -41,9 +47,11 @@ def const_text(typ, value):
     return repr(value)
 
 
-def definition(consts, fields):
+def definition(consts, fields, defaults=None):
+    defaults = defaults or {}
     lines = ["%s %s=%s" % (t, n, const_text(t, v)) for n, t, v in consts]
-    lines += ["%s %s" % (type_text(s), n) for n, s in fields if n != EMPTY]
+    lines += [("%s %s %s" % (type_text(s), n, defaults[n])) if n in defaults else "%s %s" % (type_text(s), n)
+              for n, s in fields if n != EMPTY]
     return "".join(l + "\n" for l in lines)
 
 
@@ -56,7 +64,7 @@ def main():
         if pkg not in PACKAGES:
             continue
         path = OUT / pkg / kind / (short + ".msg")
-        text = definition(consts, fields)
+        text = definition(consts, fields, DEFAULTS.get(name))
         if check:
             if not path.exists() or path.read_text() != text:
                 print("differs:", path)

@@ -197,6 +197,23 @@ def test_every_bundled_type_round_trips_byte_exact(rvc):
         round_trip(rvc, ts, name, rng, 6, ts_name=service_alias(name))
 
 
+def test_bundled_defaults(rvc):
+    """Fields a message leaves out take the published definitions' defaults when encoded: a Pose with no
+    orientation is the identity rotation (geometry_msgs/Quaternion's w defaults to 1). Oracle: rosbags
+    decodes the bytes rvc writes."""
+    ts = get_typestore(Stores.ROS2_JAZZY)
+    for typ, given, expect in [
+        ("geometry_msgs/msg/Quaternion", {}, {"x": 0.0, "y": 0.0, "z": 0.0, "w": 1.0}),
+        ("geometry_msgs/msg/Pose", {"position": {"x": 2.0}}, {"x": 0.0, "y": 0.0, "z": 0.0, "w": 1.0}),
+    ]:
+        r = subprocess.run([rvc, "msg", "encode", "--type", typ], input=json.dumps(given) + "\n",
+                           capture_output=True, text=True, timeout=30)
+        assert r.returncode == 0, r.stderr
+        msg = ts.deserialize_cdr(bytes.fromhex(r.stdout.split()[0]), typ)
+        q = msg if typ.endswith("Quaternion") else msg.orientation
+        assert {k: getattr(q, k) for k in "xyzw"} == expect, (typ, r.stdout)
+
+
 PRIMS = ["bool", "byte", "char", "int8", "uint8", "int16", "uint16", "int32", "uint32", "int64", "uint64",
          "float32", "float64", "string"]
 
