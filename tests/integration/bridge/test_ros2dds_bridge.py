@@ -30,6 +30,7 @@ import time
 import pytest
 
 from conftest import transports_built
+from ros_idl_types import ros_idl_types
 from ros_node import announce_node
 from rvc_testlib import dds_matched
 from test_python_peers import HANG_GUARD, free_port, wait_for, zsession
@@ -60,26 +61,8 @@ def ros(rvc):
     if not {"dds", "zenoh"} <= set(transports_built(rvc)):
         pytest.skip("rvc built without Zenoh or DDS")
     pytest.importorskip("cyclonedds")
-    from dataclasses import dataclass
-
-    from cyclonedds.idl import IdlStruct
-    from cyclonedds.idl.types import int32, uint8, uint32
-
-    @dataclass
-    class Time_(IdlStruct, typename="builtin_interfaces::msg::dds_::Time_"):
-        sec: int32
-        nanosec: uint32
-
-    @dataclass
-    class GearReport_(IdlStruct, typename="autoware_auto_vehicle_msgs::msg::dds_::GearReport_"):
-        stamp: Time_
-        report: uint8
-
-    @dataclass
-    class Bool_(IdlStruct, typename="std_msgs::msg::dds_::Bool_"):
-        data: bool
-
-    return {"Time": Time_, "Gear": GearReport_, "Bool": Bool_}
+    t = ros_idl_types()
+    return {"Time": t.Time_, "Gear": t.GearReport_, "Bool": t.Bool_}
 
 
 class Bridge:

@@ -14,45 +14,31 @@ import time
 import pytest
 
 from conftest import transports_built
-from ros_idl_types import loopback_dds
+from ros_idl_types import loopback_dds, ros_idl_types
 from rvc_testlib import dds_matched
 from test_python_peers import HANG_GUARD, wait_for
 
 
 def set_bool_event_types():
-    from dataclasses import dataclass
+    t = ros_idl_types()
+    return t.Time_, t.ServiceEventInfo_, t.SetBool_Request_, t.SetBool_Response_, t.SetBool_Event_
 
-    from cyclonedds.idl import IdlStruct
-    from cyclonedds.idl.types import array, int32, int64, sequence, uint8, uint32
 
-    @dataclass
-    class Time_(IdlStruct, typename="builtin_interfaces::msg::dds_::Time_"):
-        sec: int32
-        nanosec: uint32
+def write_two_calls(writer):
+    """Client 1's call (its request seen on both sides, answered 40 ms later) and client 2's request,
+    never answered; the events' stamps are the system clock's. Returns the first request's stamp (ns)."""
+    Time_, Info_, Req_, Resp_, Event_ = set_bool_event_types()
+    now_ns = time.time_ns()
 
-    @dataclass
-    class ServiceEventInfo_(IdlStruct, typename="service_msgs::msg::dds_::ServiceEventInfo_"):
-        event_type: uint8
-        stamp: Time_
-        client_gid: array[uint8, 16]  # char[16] in the .msg: one octet each
-        sequence_number: int64
-
-    @dataclass
-    class SetBool_Request_(IdlStruct, typename="std_srvs::srv::dds_::SetBool_Request_"):
-        data: bool
-
-    @dataclass
-    class SetBool_Response_(IdlStruct, typename="std_srvs::srv::dds_::SetBool_Response_"):
-        success: bool
-        message: str
-
-    @dataclass
-    class SetBool_Event_(IdlStruct, typename="std_srvs::srv::dds_::SetBool_Event_"):
-        info: ServiceEventInfo_
-        request: sequence[SetBool_Request_, 1]
-        response: sequence[SetBool_Response_, 1]
-
-    return Time_, ServiceEventInfo_, SetBool_Request_, SetBool_Response_, SetBool_Event_
+    def info(kind, ns, client, seq):
+        return Info_(event_type=kind, stamp=Time_(sec=ns // 10**9, nanosec=ns % 10**9),
+                     client_gid=[client] + [0] * 15, sequence_number=seq)
+    writer.write(Event_(info=info(0, now_ns, 1, 1), request=[Req_(data=True)], response=[]))
+    writer.write(Event_(info=info(1, now_ns + 1_000_000, 1, 1), request=[Req_(data=True)], response=[]))
+    writer.write(Event_(info=info(2, now_ns + 40_000_000, 1, 1), request=[],
+                        response=[Resp_(success=True, message="set")]))
+    writer.write(Event_(info=info(0, now_ns + 100_000_000, 2, 1), request=[Req_(data=False)], response=[]))
+    return now_ns
 
 
 def read_line(proc, deadline_s=HANG_GUARD):
@@ -89,7 +75,7 @@ def test_service_events_over_dds_become_calls(rvc, tmp_path, monkeypatch):
     from cyclonedds.qos import Policy, Qos
     from cyclonedds.topic import Topic
     from cyclonedds.util import duration
-    Time_, Info_, Req_, Resp_, Event_ = set_bool_event_types()
+    Event_ = set_bool_event_types()[-1]
     domain = 150 + os.getpid() % 50
     echo = subprocess.Popen([rvc, "echo", "dds:/set_bool/_service_event", "--type", "std_srvs/srv/SetBool_Event",
                              "--domain", str(domain)], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
@@ -102,16 +88,7 @@ def test_service_events_over_dds_become_calls(rvc, tmp_path, monkeypatch):
                   Policy.Durability.Volatile)
         writer = DataWriter(dp, Topic(dp, "rt/set_bool/_service_event", Event_), qos=qos)
         wait_for(lambda: dds_matched(writer), "rvc echo to match the service event topic")
-        now_ns = time.time_ns()
-
-        def info(kind, ns, client, seq):
-            return Info_(event_type=kind, stamp=Time_(sec=ns // 10**9, nanosec=ns % 10**9),
-                         client_gid=[client] + [0] * 15, sequence_number=seq)
-        writer.write(Event_(info=info(0, now_ns, 1, 1), request=[Req_(data=True)], response=[]))
-        writer.write(Event_(info=info(1, now_ns + 1_000_000, 1, 1), request=[Req_(data=True)], response=[]))
-        writer.write(Event_(info=info(2, now_ns + 40_000_000, 1, 1), request=[],
-                            response=[Resp_(success=True, message="set")]))
-        writer.write(Event_(info=info(0, now_ns + 100_000_000, 2, 1), request=[Req_(data=False)], response=[]))
+        now_ns = write_two_calls(writer)
         first = json.loads(read_line(calls))
         assert first["answered"] is True and first["latency"] == 0.04
         assert first["request"] == {"data": True} and first["response"] == {"success": True, "message": "set"}
@@ -145,7 +122,7 @@ def test_monitor_calls_pairs_service_events_over_dds_and_settles_unanswered_on_i
     from cyclonedds.qos import Policy, Qos
     from cyclonedds.topic import Topic
     from cyclonedds.util import duration
-    Time_, Info_, Req_, Resp_, Event_ = set_bool_event_types()
+    Event_ = set_bool_event_types()[-1]
     domain = 100 + os.getpid() % 50
     mon = subprocess.Popen([rvc, "monitor", "--input", "dds:/set_bool/_service_event", "--type",
                             "std_srvs/srv/SetBool_Event", "--calls", "--service-timeout", "1.5", "--all",
@@ -157,16 +134,7 @@ def test_monitor_calls_pairs_service_events_over_dds_and_settles_unanswered_on_i
                   Policy.Durability.Volatile)
         writer = DataWriter(dp, Topic(dp, "rt/set_bool/_service_event", Event_), qos=qos)
         wait_for(lambda: dds_matched(writer), "rvc monitor to match the service event topic")
-        now_ns = time.time_ns()
-
-        def info(kind, ns, client, seq):
-            return Info_(event_type=kind, stamp=Time_(sec=ns // 10**9, nanosec=ns % 10**9),
-                         client_gid=[client] + [0] * 15, sequence_number=seq)
-        writer.write(Event_(info=info(0, now_ns, 1, 1), request=[Req_(data=True)], response=[]))
-        writer.write(Event_(info=info(1, now_ns + 1_000_000, 1, 1), request=[Req_(data=True)], response=[]))
-        writer.write(Event_(info=info(2, now_ns + 40_000_000, 1, 1), request=[],
-                            response=[Resp_(success=True, message="set")]))
-        writer.write(Event_(info=info(0, now_ns + 100_000_000, 2, 1), request=[Req_(data=False)], response=[]))
+        now_ns = write_two_calls(writer)
         first = json.loads(read_line(mon))
         assert first["value"] is True
         second = json.loads(read_line(mon))  # client 2's call, made by the monitor's clock at its deadline
