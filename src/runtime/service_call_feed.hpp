@@ -49,6 +49,9 @@ class ServiceCallFeed final : public Feed {
   void end_of_input() override;
   uint64_t received() const override { return calls_.counts().events; }
   void add_dropped(io::JsonObject& out) const override;
+  // Events whose call was never checked (orphans, pending): the run is not a clean pass (exit 3).
+  // A duplicate is the other side's event of a call that was checked: it loses nothing.
+  uint64_t lost() const override { return calls_.counts().orphans + pending_events(); }
   const PipelineStats& stats() const override;
   uint64_t violations() const override { return inner_.violations(); }
   void finish_report() override;

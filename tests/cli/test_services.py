@@ -349,3 +349,24 @@ def test_calls_flag_usage_errors(rvc, tmp_path):
     assert "rvc calls" in r.stderr
     r = run([rvc, "monitor", "--calls", "--input", "a=file:x", "--input", "b=file:y", "--spec", "{a.x}"], check=2)
     assert "one --input" in r.stderr
+
+
+def test_a_call_never_checked_is_not_a_clean_pass(rvc, tmp_path):
+    """Every call checked held, but one request's call was never decided when the input ended (its
+    deadline lies past the last event) and one response answered no request seen: those events were
+    not checked, so the run is exit 3 (docs/services.md), not 0. Hand-computed; timeout 10 s."""
+    ok = [event_line(0, 1000, 1, 1, {"data": True}), event_line(3, 1010, 1, 1, None, {"success": True, "message": ""})]
+    pending = [event_line(0, 2000, 1, 2, {"data": True})]
+    orphan = [event_line(3, 3000, 2, 9, None, {"success": True, "message": ""})]
+    for extra, reason in [([], None), (pending, "pending"), (orphan, "orphan")]:
+        trace = tmp_path / "events.jsonl"
+        trace.unlink(missing_ok=True)
+        trace.write_text("\n".join(ok + extra) + "\n")
+        r = run([rvc, "monitor", "--input", f"file:{trace}", "--calls", "--service-timeout", "10",
+                 "--spec", "{answered}"])
+        counters = json.loads([l for l in r.stderr.splitlines() if l.startswith("{")][-1])
+        assert counters["checked"] == 1, r.stderr
+        if reason is None:
+            assert r.returncode == 0 and counters["dropped"] == {}, r.stderr
+        else:
+            assert r.returncode == 3 and counters["dropped"] == {reason: 1}, r.stderr
