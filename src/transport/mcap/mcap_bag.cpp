@@ -1,5 +1,7 @@
 #include "transport/mcap/mcap_bag.hpp"
 
+#include <algorithm>
+
 #include <cstring>
 #include <fstream>
 #include <vector>
@@ -41,12 +43,13 @@ bool McapBag::looks_like_mcap(const std::string& path) {
   return in.read(head, 8) && std::memcmp(head, kMagic, 8) == 0;
 }
 
-BagContents bag_topics(const std::string& path) {
+BagContents bag_topics(const std::string& path, const std::string& shown) {
   BagContents contents;
   auto& topics = contents.topics;
   McapBag bag(path);
+  const std::string& name = shown.empty() ? path : shown;
   bag.on_skip([&](const std::string& reason) {
-    if (contents.first_skipped.empty()) contents.first_skipped = "bag '" + path + "': " + reason;
+    if (contents.first_skipped.empty()) contents.first_skipped = "bag '" + name + "': " + reason;
   });
   McapMessage m;
   // Each channel's topic, found once: a bag of many channels costs no more
@@ -67,7 +70,10 @@ BagContents bag_topics(const std::string& path) {
       t.schema_name = m.schema_name;
       t.schema_encoding = m.schema_encoding;
       t.schema = m.schema;
+      t.first_time = t.last_time = m.log_time;
     }
+    t.first_time = std::min(t.first_time, m.log_time);
+    t.last_time = std::max(t.last_time, m.log_time);
   }
   return contents;
 }

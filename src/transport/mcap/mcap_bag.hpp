@@ -53,10 +53,12 @@ class McapBag {
   std::function<void(const std::string&)> on_skip_;
 };
 
-// One topic of a bag: its message count and channel (from its first message).
+// One topic of a bag: its message count, channel (from its first message) and
+// the span of its log times (ns).
 struct BagTopic {
   uint64_t messages = 0;
   std::string message_encoding, schema_name, schema_encoding, schema;
+  uint64_t first_time = 0, last_time = 0;
 };
 
 // Reads the whole bag once: every topic with its count and schema. A bag
@@ -68,6 +70,8 @@ struct BagContents {
   std::string broken;
   std::string first_skipped;  // why the first record skipped was, if any
 };
-BagContents bag_topics(const std::string& path);
+// `shown` names the bag in first_skipped (default: path). Throws McapError
+// when the file cannot be opened as MCAP.
+BagContents bag_topics(const std::string& path, const std::string& shown = "");
 
 }  // namespace rvc::transport

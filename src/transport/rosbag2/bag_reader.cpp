@@ -119,40 +119,26 @@ class McapBagReader : public BagReader {
 // schemas live in its messages' channels, per-message zstd undone first).
 void summarize_mcap(const std::string& file, const std::string& shown, BagSummary& s,
                     std::map<std::string, BagTopicInfo>& topics) {
-  std::unique_ptr<McapBag> bag;
+  BagContents contents;
   try {
-    bag = std::make_unique<McapBag>(file);
+    contents = bag_topics(file, shown);
   } catch (const McapError& e) {
     throw BagError(e.what());
   }
-  bag->on_skip([&](const std::string& why) {
-    if (s.first_skipped.empty()) s.first_skipped = "bag '" + shown + "': " + why;
-  });
-  std::map<std::string, BagTopicInfo> found;
-  std::vector<BagTopicInfo*> by_channel(65536, nullptr);  // each channel's topic, found once
-  McapMessage m;
-  for (;;) {
-    try {
-      if (!bag->next(m)) break;
-    } catch (const McapError& e) {
-      if (s.broken.empty()) s.broken = e.what();
-      break;
-    }
-    BagTopicInfo*& slot = by_channel[m.channel_id];
-    if (!slot) slot = &found[std::string(m.topic)];
-    BagTopicInfo& t = *slot;
-    if (t.messages++ == 0) {
-      t.name = m.topic;
-      t.type = m.schema_name;
-      t.encoding = m.message_encoding;
-      t.definition_encoding = m.schema_encoding;
-      t.definition = m.schema;
-      t.first_time = t.last_time = m.log_time;
-    }
-    t.first_time = std::min(t.first_time, m.log_time);
-    t.last_time = std::max(t.last_time, m.log_time);
+  if (s.first_skipped.empty()) s.first_skipped = contents.first_skipped;
+  if (s.broken.empty()) s.broken = contents.broken;
+  for (const auto& [name, c] : contents.topics) {
+    BagTopicInfo t;
+    t.name = name;
+    t.type = c.schema_name;
+    t.encoding = c.message_encoding;
+    t.definition_encoding = c.schema_encoding;
+    t.definition = c.schema;
+    t.messages = c.messages;
+    t.first_time = c.first_time;
+    t.last_time = c.last_time;
+    merge_topic(topics, t);
   }
-  for (const auto& [name, t] : found) merge_topic(topics, t);
 }
 #endif
 
