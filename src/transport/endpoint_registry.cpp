@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "transport/file_endpoint.hpp"
+#include "transport/mcap/mcap_sink.hpp"
 #include "transport/transport_options.hpp"
 #ifdef RVC_HAVE_ZENOH
 #include "transport/zenoh/rvc_zenoh.h"
@@ -117,7 +118,12 @@ std::unique_ptr<Source> open_source(const std::string& uri, const TransportOptio
 
 std::unique_ptr<Sink> open_sink(const std::string& uri, const TransportOptions& options) {
   Parsed p = parse(uri);
-  if (p.scheme == "mcap") throw std::invalid_argument("'" + uri + "': rvc reads bags (bag:, mcap:), it does not write them");
+  // mcap:PATH as an output: verdicts in an MCAP file (bag:PATH names only inputs).
+  if (p.scheme == "mcap") {
+    if (uri.rfind("bag:", 0) == 0)
+      throw std::invalid_argument("'" + uri + "': rvc reads bags (bag:), it writes verdicts to mcap:PATH");
+    return std::make_unique<mcap::McapSink>(p.rest);
+  }
   if (p.scheme == "file") return std::make_unique<FileSink>(p.rest);
   if (p.scheme == "rmw_zenoh") {
 #ifdef RVC_HAVE_ZENOH
