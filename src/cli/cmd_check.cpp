@@ -27,7 +27,7 @@ namespace {
 
 std::string strip_file_scheme(const std::string& uri) {
   if (uri.rfind("file:", 0) == 0) return uri.substr(5);
-  if (uri.rfind("mcap:", 0) == 0) return uri.substr(5);  // verdicts as MCAP (docs/mcap-output.md)
+  if (uri.rfind("mcap:", 0) == 0) return uri.substr(5, uri.rfind("?inputs=") - 5);  // verdicts as MCAP (docs/mcap-output.md)
   return uri;
 }
 

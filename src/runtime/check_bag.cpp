@@ -75,6 +75,10 @@ BagInput select_bag_topic(const std::string& path, const std::string& topic, msg
   }
   const transport::BagTopicInfo& t = *contents.topic(in.topic);
   in.messages = t.messages;
+  in.type_name = t.type;
+  in.encoding = t.encoding;
+  in.definition_encoding = t.definition.empty() ? "" : t.definition_encoding;
+  in.definition = t.definition;
   if (t.encoding == "json") return in;  // JSON messages: the usual path
   if (t.encoding != "cdr")
     throw std::invalid_argument("topic '" + in.topic + "' of bag '" + path + "' is encoded as '" + t.encoding +
@@ -122,6 +126,7 @@ Outcome check_bag(const std::vector<BagInput>& inputs, Feed& feed, VerdictOutput
       outcome.rejected = true;
     });
     transport::BagMessage m;
+    const bool copy_inputs = outputs.wants_inputs();
     double end_log = 0;  // the latest log time of any message: where the recording ends
     uint64_t end_log_ns = 0;  // the same, exact (mcap: outputs)
     double last_stamp = std::numeric_limits<double>::quiet_NaN(), stamp_log = 0;
@@ -149,6 +154,9 @@ Outcome check_bag(const std::vector<BagInput>& inputs, Feed& feed, VerdictOutput
         if (m.topic == inputs[i].topic) {
           outputs.set_step_time(m.log_time);  // mcap: outputs place this step's verdicts at its log time
           feed.feed_logged(static_cast<uint32_t>(i), m.data, m.index, log_time);
+          if (copy_inputs)  // after its step's verdicts: log times never go back in the file
+            outputs.put_input({m.topic, inputs[i].type_name, inputs[i].encoding, inputs[i].definition_encoding,
+                               inputs[i].definition, m.data, m.log_time});
           const double stamp = feed.last_stamp();
           if (!(stamp == last_stamp)) {  // the monitors took a message: stream time `stamp` at this log time
             last_stamp = stamp;

@@ -40,6 +40,17 @@ class VerdictOutputs {
   }
   void use_wall_clock(bool wall_clock) { wall_clock_ = wall_clock; }
   bool has_timeline_sinks() const { return !timeline_.empty(); }
+  // Whether a timeline sink copies the input messages (mcap:PATH?inputs=1),
+  // and the copy: after the verdicts of the message's step.
+  bool wants_inputs() const {
+    for (auto* t : timeline_)
+      if (t->wants_inputs()) return true;
+    return false;
+  }
+  void put_input(const transport::InputMessage& message) {
+    for (auto* t : timeline_)
+      if (t->wants_inputs()) t->put_input(message);
+  }
 
   // Also hands every verdict to `observer` (the results store, the
   // enforcer), before the sinks, in the engine thread.

@@ -58,8 +58,11 @@ bool endpoints_overlap(const std::string& a, const std::string& b) {
   for (Parsed* p : {&pa, &pb})
     if (p->scheme == "rmw_zenoh") *p = {"zenoh", rmw_zenoh::data_keyexpr(rmw_zenoh::domain_id_from_env(), p->rest)};
   // A bag is a file: writing verdicts over it is reading back one's output.
-  if (pa.scheme == "mcap") pa.scheme = "file";
-  if (pb.scheme == "mcap") pb.scheme = "file";
+  for (Parsed* p : {&pa, &pb})
+    if (p->scheme == "mcap") {
+      p->scheme = "file";
+      if (const size_t q = p->rest.rfind("?inputs="); q != std::string::npos) p->rest.resize(q);  // an output's option
+    }
   if (pa.scheme != pb.scheme) return false;
   if (pa.scheme == "file") {
     if (pa.rest == "-" || pb.rest == "-") return false;  // stdin and stdout are different streams

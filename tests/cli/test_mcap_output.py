@@ -133,6 +133,27 @@ def test_bag_verdicts_sit_at_their_messages_log_times(rvc, tmp_path):
     want = json_lines(jl.read_text())
     assert len(want) == len(reports)
     assert_equal_verdicts(mc, jl.read_text(), [times[int(w["time"])] for w in want])
+    # ?inputs=1: the bag's messages too, byte-equal, at their log times, with the bag's schema.
+    both = tmp_path / "both.mcap"
+    b = run([rvc, "check", "--all", "--spec", spec, str(bag), "--topic", GEAR_TOPIC, "-o", f"mcap:{both}?inputs=1"])
+    assert b.returncode == 1 and not (tmp_path / "both.mcap?inputs=1").exists(), b.stderr
+    from mcap.reader import make_reader
+    with open(bag, "rb") as f:
+        reader = make_reader(f)
+        (bag_schema,) = reader.get_summary().schemas.values()
+        bag_msgs = [(m.log_time, m.data) for _, _, m in reader.iter_messages()]
+    _, summary, msgs = read_mcap(both)
+    copied = [(m[1], m[4]) for m in msgs if m[0] == GEAR_TOPIC]
+    assert copied == bag_msgs and len(copied) == len(reports)
+    schema = next(s for s in summary.schemas.values() if s.name == GEAR)
+    assert (schema.encoding, schema.data) == (bag_schema.encoding, bag_schema.data)
+    verdicts_only = [m for m in msgs if m[0] == "/rvc/verdicts"]
+    assert verdicts_only == read_mcap(mc)[2]
+    # rosbags reads both topics from the one file: the data and its verdicts on one timeline.
+    got = read_rosbags(both)
+    gears = [(t, g.report) for topic, _, t, g in got if topic == GEAR_TOPIC]
+    assert gears == list(zip(times, reports))
+    assert [t for topic, _, t, _ in got] == sorted(t for topic, _, t, _ in got)
 
 
 @pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])

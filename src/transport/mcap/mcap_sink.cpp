@@ -25,6 +25,14 @@ std::string ros2msg_schema(const std::string& full_name, const std::vector<std::
 }
 
 McapSink::McapSink(std::string path) : path_(std::move(path)) {
+  // Options after '?' (a path with a '?' of its own: name it ./a?b?inputs=0).
+  if (const size_t q = path_.rfind('?'); q != std::string::npos) {
+    const std::string option = path_.substr(q + 1);
+    if (option == "inputs=1" || option == "inputs=true") inputs_ = true;
+    else if (option != "inputs=0" && option != "inputs=false")
+      throw std::invalid_argument("mcap:" + path_ + ": unknown option '" + option + "' (mcap:PATH?inputs=1 copies the inputs)");
+    path_.resize(q);
+  }
   if (path_ == "-") throw std::invalid_argument("mcap: writes a file: give its path (mcap:PATH), not '-'");
   file_ = open_output_file(path_, "--output");  // refuses a file rvc did not write, marks this one
   try {
@@ -51,6 +59,21 @@ void McapSink::fail(const std::string& what) const { throw std::runtime_error("c
 void McapSink::put_verdict(std::string_view cdr, uint64_t log_time_ns) {
   try {
     writer_->write_message(verdict_channel_, ++sequence_, log_time_ns, log_time_ns, cdr);
+  } catch (const std::runtime_error& e) {
+    fail(e.what());
+  }
+}
+
+void McapSink::put_input(const InputMessage& m) {
+  try {
+    auto it = input_channels_.find(m.topic);
+    if (it == input_channels_.end()) {
+      const uint16_t schema =
+          m.schema_encoding.empty() ? 0 : writer_->add_schema(m.type, m.schema_encoding, m.schema);
+      it = input_channels_.emplace(std::string(m.topic), InputChannel{writer_->add_channel(schema, m.topic, m.message_encoding)})
+               .first;
+    }
+    writer_->write_message(it->second.id, ++it->second.sequence, m.log_time_ns, m.log_time_ns, m.data);
   } catch (const std::runtime_error& e) {
     fail(e.what());
   }

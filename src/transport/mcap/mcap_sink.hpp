@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdio>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -22,9 +23,13 @@ inline constexpr const char* kVerdictType = "rvc_msgs/msg/Verdict";
 
 class McapSink final : public Sink, public VerdictSink {
  public:
-  explicit McapSink(std::string path);  // refuses a file rvc did not write (output_file.hpp)
+  // PATH, or PATH?inputs=1: also the input messages (a bag's) on their own topics.
+  // Refuses a file rvc did not write (output_file.hpp).
+  explicit McapSink(std::string path);
   ~McapSink() override;                 // closes the file if put_eos did not; never throws
   void put_verdict(std::string_view cdr, uint64_t log_time_ns) override;
+  bool wants_inputs() const override { return inputs_; }
+  void put_input(const InputMessage& message) override;
   // A payload that is not a verdict (rvc sync's sets): MCAP outputs take verdicts only.
   void put(std::string_view payload, uint64_t seq) override;
   void put_eos(uint64_t last_seq) override;
@@ -39,6 +44,12 @@ class McapSink final : public Sink, public VerdictSink {
   std::unique_ptr<McapWriter> writer_;
   uint16_t verdict_channel_ = 0;
   uint32_t sequence_ = 0;
+  bool inputs_ = false;
+  struct InputChannel {
+    uint16_t id;
+    uint32_t sequence = 0;
+  };
+  std::map<std::string, InputChannel, std::less<>> input_channels_;  // by topic
 };
 
 // The ros2msg schema text of a bundled type followed by the bundled types it
