@@ -24,10 +24,29 @@ def run(args, **kw):
     return subprocess.run(args, capture_output=True, text=True, timeout=120, **kw)
 
 
+def check_crcs(path):
+    """The data section's CRC (checked by the mcap package's stream reader) and the summary's CRC in
+    the Footer (checked here with zlib: the package does not check that one)."""
+    import struct
+    import zlib
+    from mcap.records import DataEnd
+    from mcap.stream_reader import StreamReader
+    with open(path, "rb") as f:
+        ends = [r for r in StreamReader(f, validate_crcs=True).records if isinstance(r, DataEnd)]
+    assert len(ends) == 1 and ends[0].data_section_crc != 0
+    data = open(path, "rb").read()
+    footer = data[-37:-8]
+    assert footer[:9] == b"\x02" + struct.pack("<Q", 20)
+    summary_start, offsets_start, crc = struct.unpack("<QQI", footer[9:])
+    assert 0 < summary_start < offsets_start < len(data) - 37
+    assert crc == zlib.crc32(data[summary_start:len(data) - 12])
+
+
 def read_mcap(path):
     """(header, summary, [(topic, log_time, publish_time, sequence, data)]) through the mcap package,
-    every CRC it carries checked."""
+    every CRC the file carries checked."""
     from mcap.reader import make_reader
+    check_crcs(path)
     with open(path, "rb") as f:
         reader = make_reader(f, validate_crcs=True)
         header, summary = reader.get_header(), reader.get_summary()

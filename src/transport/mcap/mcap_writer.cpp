@@ -76,6 +76,7 @@ void McapWriter::emit(std::string_view bytes) {
   if (std::fwrite(bytes.data(), 1, bytes.size(), file_) != bytes.size())
     throw std::runtime_error(std::strerror(errno ? errno : EIO));
   offset_ += bytes.size();
+  if (!closed_) data_crc_ = crc32(bytes, data_crc_);  // the data section: from the magic up to DataEnd
 }
 
 void McapWriter::schema_record(std::string& out, const Schema& s) {
@@ -144,10 +145,10 @@ void McapWriter::write_message(uint16_t channel_id, uint32_t sequence, uint64_t 
 
 void McapWriter::close() {
   if (closed_) return;
-  closed_ = true;
+  closed_ = true;  // from here on, bytes are not part of the data section's CRC
   record_.clear();
   begin_record(record_, kDataEnd);
-  put_int<uint32_t>(record_, 0);  // data section CRC: 0 = not computed
+  put_int<uint32_t>(record_, data_crc_);
   end_record(record_, 0);
   emit(record_);
 
@@ -199,12 +200,11 @@ void McapWriter::close() {
     end_record(summary, begin);
   }
   // Footer: the CRC covers the summary and offsets and the footer up to the CRC itself.
-  const size_t footer = summary.size();
-  begin_record(summary, kFooter);
+  summary.push_back(static_cast<char>(kFooter));
+  put_int<uint64_t>(summary, 8 + 8 + 4);  // its length, written before the CRC that covers it
   put_int<uint64_t>(summary, summary_start);
   put_int<uint64_t>(summary, offsets_start);
   put_int<uint32_t>(summary, crc32(summary));
-  end_record(summary, footer);
   summary.append(kMagic, sizeof kMagic);
   emit(summary);
   if (std::fflush(file_) != 0) throw std::runtime_error(std::strerror(errno ? errno : EIO));

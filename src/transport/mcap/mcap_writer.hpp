@@ -3,7 +3,8 @@
 // message written before the cut, and a reader that scans linearly gets them.
 //
 //   magic, Header(profile, library), data: Schema / Channel records (each before
-//   its channel's first message) and Message records, DataEnd, summary (every
+//   its channel's first message) and Message records, DataEnd (with the CRC of
+//   everything before it), summary (every
 //   Schema and Channel again, Statistics), Summary Offset records, Footer, magic
 //
 // close() writes everything after the data section; until then the file has no
@@ -56,6 +57,7 @@ class McapWriter {
 
   std::FILE* file_;
   uint64_t offset_ = 0;
+  uint32_t data_crc_ = 0;  // CRC-32 of every byte written before DataEnd
   std::vector<Schema> schemas_;
   std::vector<Channel> channels_;
   std::map<uint16_t, uint64_t> per_channel_;
