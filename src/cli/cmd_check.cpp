@@ -10,6 +10,7 @@
 #include "cli/check_options.hpp"
 #include "cli/clock_options.hpp"
 #include "cli/commands.hpp"
+#include "cli/output_sinks.hpp"
 #include "cli/signals.hpp"
 #include "cli/store_options.hpp"
 #include "io/json_writer.hpp"
@@ -76,6 +77,7 @@ struct CheckCommand {
                      path.c_str(), what.c_str());
         return kUsage;
       }
+    if (int status = refuse_input_copies({output}, path == "-" ? "stdin" : path)) return status;
     if (check.calls) {
       std::fprintf(stderr, "rvc: --calls pairs the service events of a bag's topic (or a live input: rvc monitor "
                            "--calls); for JSON lines pipe them through `rvc calls` into `rvc check -`\n");

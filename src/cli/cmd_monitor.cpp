@@ -476,8 +476,10 @@ struct MonitorCommand {
   int run() {
     if (!store.take_database(outputs)) return kUsage;
     if (outputs.empty()) outputs.push_back("-");
+    const bool bag = !SyncFlags::named(inputs) && is_bag_input(inputs.at(0));
+    if (!bag)
+      if (int status = refuse_input_copies(outputs, inputs.at(0))) return status;
     if (SyncFlags::named(inputs)) return run_synced();
-    const bool bag = is_bag_input(inputs.at(0));
     if (!bag && refuse_binary_file(inputs.at(0))) return kUsage;
     if (!bag && (!sync.stamps.empty() || app->count("--sync") || app->count("--pivot") || app->count("--lower-bound"))) {
       std::fprintf(stderr, "rvc: --stamp, --sync, --pivot and --lower-bound synchronize several inputs: give them as "

@@ -26,4 +26,16 @@ int open_outputs(const std::vector<std::string>& uris, const transport::Transpor
   return 0;
 }
 
+int refuse_input_copies(const std::vector<std::string>& outputs, const std::string& input) {
+  for (const auto& uri : outputs)
+    if (uri.rfind("mcap:", 0) == 0 && (uri.ends_with("?inputs=1") || uri.ends_with("?inputs=true"))) {
+      std::fprintf(stderr,
+                   "rvc: %s copies the messages of a ROS 2 bag (rvc check BAG, --input bag:BAG); the messages of %s "
+                   "are not copied: drop ?inputs=1 (docs/mcap-output.md)\n",
+                   uri.c_str(), input.c_str());
+      return kUsage;
+    }
+  return 0;
+}
+
 }  // namespace rvc::cli

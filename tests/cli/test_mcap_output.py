@@ -222,7 +222,14 @@ def test_never_writes_over_a_file_rvc_did_not_create(rvc, tmp_path):
         r = run([rvc, "check", "--spec", "{x < 5}", str(trace), "-o", f"mcap:{own}"])
         assert r.returncode == 1, r.stderr
     assert read_mcap(own)[1].statistics.message_count == 3  # true, false at x = 7, true again
-    # Reading a bag and writing verdicts over it is refused.
+    # ?inputs=1 copies a bag's messages: with JSON lines nothing would be copied, so it is refused.
+    for cmd in ([rvc, "check", "--spec", "{x < 5}", str(trace), "-o", f"mcap:{tmp_path / 'in.mcap'}?inputs=1"],
+                [rvc, "monitor", "--spec", "{x < 5}", "--input", f"file:{trace}", "--output",
+                 f"mcap:{tmp_path / 'in.mcap'}?inputs=1"]):
+        r = run(cmd)
+        assert r.returncode == 2 and "copies the messages of a ROS 2 bag" in r.stderr, r.stderr
+        assert not (tmp_path / "in.mcap").exists()
+    # Reading a file and writing verdicts over it is refused.
     r = run([rvc, "monitor", "--spec", "{x < 5}", "--input", f"file:{trace}", "--output", f"mcap:{trace}"])
     assert r.returncode == 2, r.stderr
     assert trace.read_text().startswith('{"time"')
