@@ -12,7 +12,7 @@ int open_outputs(const std::vector<std::string>& uris, const transport::Transpor
                  std::vector<std::unique_ptr<transport::Sink>>& sinks) {
   for (const auto& uri : uris) sinks.push_back(transport::open_sink(uri, transports));
   for (size_t i = 0; i < sinks.size() && wait_subscribers > 0; ++i) {
-    if (transport::scheme_of(uris[i]) == "file") continue;
+    if (transport::scheme_of(uris[i]) == "file" || transport::scheme_of(uris[i]) == "mcap") continue;  // no subscribers
     std::fprintf(stderr, "rvc %s: waiting for %zu subscriber%s on %s ...\n", who, wait_subscribers,
                  wait_subscribers == 1 ? "" : "s", uris[i].c_str());
     if (!sinks[i]->wait_matched(wait_subscribers, std::chrono::milliseconds(static_cast<long>(wait_timeout * 1000)))) {
