@@ -10,6 +10,7 @@
 #include "cli/check_options.hpp"
 #include "cli/clock_options.hpp"
 #include "cli/commands.hpp"
+#include "cli/output_sinks.hpp"
 #include "cli/signals.hpp"
 #include "cli/store_options.hpp"
 #include "io/json_writer.hpp"
@@ -20,11 +21,22 @@
 #include "runtime/check_bag.hpp"
 #include "transport/rosbag2/bag_reader.hpp"
 #include "transport/file_endpoint.hpp"
+#include "transport/transport_options.hpp"
 
 namespace rvc::cli {
 namespace {
 
-std::string strip_file_scheme(const std::string& uri) { return uri.rfind("file:", 0) == 0 ? uri.substr(5) : uri; }
+std::string strip_file_scheme(const std::string& uri) {
+  if (uri.rfind("file:", 0) == 0) return uri.substr(5);
+  if (uri.rfind("mcap:", 0) == 0) return uri.substr(5, uri.rfind("?inputs=") - 5);  // verdicts as MCAP (docs/mcap-output.md)
+  return uri;
+}
+
+// The one verdict output of rvc check: JSON lines (a path, file:PATH, -) or mcap:PATH.
+std::unique_ptr<transport::Sink> open_verdict_sink(const std::string& output) {
+  if (output.rfind("mcap:", 0) == 0) return transport::open_sink(output, {});
+  return std::make_unique<transport::FileSink>(strip_file_scheme(output));
+}
 
 struct CheckCommand {
   CheckOptions check;
@@ -65,6 +77,7 @@ struct CheckCommand {
                      path.c_str(), what.c_str());
         return kUsage;
       }
+    if (int status = refuse_input_copies({output}, path == "-" ? "stdin" : path)) return status;
     if (check.calls) {
       std::fprintf(stderr, "rvc: --calls pairs the service events of a bag's topic (or a live input: rvc monitor "
                            "--calls); for JSON lines pipe them through `rvc calls` into `rvc check -`\n");
@@ -85,7 +98,7 @@ struct CheckCommand {
       }
     }
     std::vector<std::unique_ptr<transport::Sink>> sinks;
-    sinks.push_back(std::make_unique<transport::FileSink>(opath));
+    sinks.push_back(open_verdict_sink(output));
     runtime::VerdictOutputs outputs(std::move(sinks), !check.dense);
     runtime::PipelineOptions popts = check.pipeline_options();
     // A bad spec ends the run before the database is opened: a refused run
@@ -132,7 +145,7 @@ struct CheckCommand {
               const std::string& opath) {
     for (const auto& dir : msg_paths) registry.add_search_path(dir);
     std::vector<std::unique_ptr<transport::Sink>> sinks;
-    sinks.push_back(std::make_unique<transport::FileSink>(opath));
+    sinks.push_back(open_verdict_sink(output));
     runtime::VerdictOutputs outputs(std::move(sinks), !check.dense);
     runtime::PipelineOptions popts = check.pipeline_options();
     auto results = store.open();
@@ -195,7 +208,8 @@ Runner register_check(CLI::App& app) {
   cmd->sync.add_to(*sub);
   cmd->clock.add_offline(*sub);
   sub->add_option("--output,-o", cmd->outputs,
-                  "Where verdicts go: PATH, file:PATH or - (stdout, the default); repeatable for results databases: "
+                  "Where verdicts go: PATH, file:PATH or - (stdout, the default), or mcap:PATH (an MCAP file for "
+                  "Foxglove, docs/mcap-output.md); repeatable for results databases: "
                   "sqlite:PATH or postgresql://... (docs/results.md)");
   cmd->store.add_to(*sub);
   sub->add_flag("--summary", cmd->summary, "Print message counts to stderr at the end");

@@ -294,6 +294,14 @@ struct MonitorCommand {
 
   runtime::VerdictOutputs make_verdicts(std::vector<std::unique_ptr<transport::Sink>> sinks) {
     runtime::VerdictOutputs verdicts(std::move(sinks), !check.dense);
+    // mcap: outputs place verdicts of live inputs at the wall-clock time they were made (the
+    // timeline of a `ros2 bag record` made alongside); a bag's at its messages' log times.
+    for (const auto& in : inputs) {
+      const size_t eq = in.find('='), colon = in.find(':');
+      const std::string scheme =
+          transport::scheme_of(eq != std::string::npos && (colon == std::string::npos || eq < colon) ? in.substr(eq + 1) : in);
+      if (scheme == "zenoh" || scheme == "dds" || scheme == "rmw_zenoh") verdicts.use_wall_clock(true);
+    }
     if (verdict_msg_type()) {
       std::vector<bool> typed_sinks;
       // rmw_zenoh: outputs stay std_msgs/String JSON (a typed key needs the type's REP-2016 hash).
@@ -468,8 +476,10 @@ struct MonitorCommand {
   int run() {
     if (!store.take_database(outputs)) return kUsage;
     if (outputs.empty()) outputs.push_back("-");
+    const bool bag = !SyncFlags::named(inputs) && is_bag_input(inputs.at(0));
+    if (!bag)
+      if (int status = refuse_input_copies(outputs, inputs.at(0))) return status;
     if (SyncFlags::named(inputs)) return run_synced();
-    const bool bag = is_bag_input(inputs.at(0));
     if (!bag && refuse_binary_file(inputs.at(0))) return kUsage;
     if (!bag && (!sync.stamps.empty() || app->count("--sync") || app->count("--pivot") || app->count("--lower-bound"))) {
       std::fprintf(stderr, "rvc: --stamp, --sync, --pivot and --lower-bound synchronize several inputs: give them as "

@@ -20,4 +20,9 @@ int open_outputs(const std::vector<std::string>& uris, const transport::Transpor
                  size_t wait_subscribers, double wait_timeout, const char* who,
                  std::vector<std::unique_ptr<transport::Sink>>& sinks);
 
+// mcap:PATH?inputs=1 copies a bag's messages only: with another input (JSON
+// lines, live topics) nothing would be copied, so the run is refused instead.
+// Returns 0, or kUsage after printing why.
+int refuse_input_copies(const std::vector<std::string>& outputs, const std::string& input);
+
 }  // namespace rvc::cli

@@ -3,8 +3,10 @@
 // shortest form that reads back to the same double.
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "io/json_writer.hpp"
 
@@ -15,5 +17,11 @@ void append_verdict(std::string& out, double time, bool discrete, std::string_vi
 // The same with a robustness value: {"time":3,"property":"p1","value":-1.5}
 // (infinities as the strings "inf" and "-inf", as JSON has no number for them).
 void append_robustness(std::string& out, double time, bool discrete, std::string_view property, double value);
+
+// Appends one verdict as a CDR sample of rvc_msgs/msg/Verdict (src/msg/definitions;
+// little-endian, with its 4-byte encapsulation header): time, property, value,
+// stamp (from `stamp_ns`), robustness (NaN for a Boolean verdict), explanation.
+void append_verdict_cdr(std::string& out, double time, std::string_view property, bool value, uint64_t stamp_ns,
+                        double robustness, const std::vector<std::string>* explanation);
 
 }  // namespace rvc::io

@@ -75,6 +75,10 @@ BagInput select_bag_topic(const std::string& path, const std::string& topic, msg
   }
   const transport::BagTopicInfo& t = *contents.topic(in.topic);
   in.messages = t.messages;
+  in.type_name = t.type;
+  in.encoding = t.encoding;
+  in.definition_encoding = t.definition.empty() ? "" : t.definition_encoding;
+  in.definition = t.definition;
   if (t.encoding == "json") return in;  // JSON messages: the usual path
   if (t.encoding != "cdr")
     throw std::invalid_argument("topic '" + in.topic + "' of bag '" + path + "' is encoded as '" + t.encoding +
@@ -122,7 +126,9 @@ Outcome check_bag(const std::vector<BagInput>& inputs, Feed& feed, VerdictOutput
       outcome.rejected = true;
     });
     transport::BagMessage m;
+    const bool copy_inputs = outputs.wants_inputs();
     double end_log = 0;  // the latest log time of any message: where the recording ends
+    uint64_t end_log_ns = 0;  // the same, exact (mcap: outputs)
     double last_stamp = std::numeric_limits<double>::quiet_NaN(), stamp_log = 0;
     for (uint64_t n = 0;; ++n) {
       // Asked every 64 messages: a stop signal ends the bag within microseconds.
@@ -143,9 +149,14 @@ Outcome check_bag(const std::vector<BagInput>& inputs, Feed& feed, VerdictOutput
       }
       const double log_time = m.log_time * 1e-9;
       end_log = std::max(end_log, log_time);
+      end_log_ns = std::max(end_log_ns, m.log_time);
       for (size_t i = 0; i < inputs.size(); ++i)
         if (m.topic == inputs[i].topic) {
+          outputs.set_step_time(m.log_time);  // mcap: outputs place this step's verdicts at its log time
           feed.feed_logged(static_cast<uint32_t>(i), m.data, m.index, log_time);
+          if (copy_inputs)  // after its step's verdicts: log times never go back in the file
+            outputs.put_input({m.topic, inputs[i].type_name, inputs[i].encoding, inputs[i].definition_encoding,
+                               inputs[i].definition, m.data, m.log_time});
           const double stamp = feed.last_stamp();
           if (!(stamp == last_stamp)) {  // the monitors took a message: stream time `stamp` at this log time
             last_stamp = stamp;
@@ -155,6 +166,7 @@ Outcome check_bag(const std::vector<BagInput>& inputs, Feed& feed, VerdictOutput
     }
     // Stopped by a signal, the recording did not end where reading did.
     if (tick_at_end && !outcome.incomplete && !std::isnan(last_stamp)) {
+      outputs.set_step_time(end_log_ns);
       feed.end_of_input();  // what a synchronizer still holds, first: checked as the recording ends
       if (const double stamp = feed.last_stamp(); !(stamp == last_stamp)) {
         last_stamp = stamp;

@@ -22,6 +22,8 @@ struct BagInput {
   const msg::MessageType* type = nullptr;  // CDR samples of this type; null: JSON messages
   uint64_t messages = 0;                 // of that topic
   bool bag_definition = false;           // its definition came from the bag (not --msg-path or bundled)
+  // As the bag records the topic (copied with its messages by mcap:PATH?inputs=1).
+  std::string type_name, encoding, definition_encoding, definition;
 };
 
 // When no sample of a topic decoded and its definition came from the bag:

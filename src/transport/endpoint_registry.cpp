@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "transport/file_endpoint.hpp"
+#include "transport/mcap/mcap_sink.hpp"
 #include "transport/transport_options.hpp"
 #ifdef RVC_HAVE_ZENOH
 #include "transport/zenoh/rvc_zenoh.h"
@@ -57,8 +58,11 @@ bool endpoints_overlap(const std::string& a, const std::string& b) {
   for (Parsed* p : {&pa, &pb})
     if (p->scheme == "rmw_zenoh") *p = {"zenoh", rmw_zenoh::data_keyexpr(rmw_zenoh::domain_id_from_env(), p->rest)};
   // A bag is a file: writing verdicts over it is reading back one's output.
-  if (pa.scheme == "mcap") pa.scheme = "file";
-  if (pb.scheme == "mcap") pb.scheme = "file";
+  for (Parsed* p : {&pa, &pb})
+    if (p->scheme == "mcap") {
+      p->scheme = "file";
+      if (const size_t q = p->rest.rfind("?inputs="); q != std::string::npos) p->rest.resize(q);  // an output's option
+    }
   if (pa.scheme != pb.scheme) return false;
   if (pa.scheme == "file") {
     if (pa.rest == "-" || pb.rest == "-") return false;  // stdin and stdout are different streams
@@ -117,7 +121,12 @@ std::unique_ptr<Source> open_source(const std::string& uri, const TransportOptio
 
 std::unique_ptr<Sink> open_sink(const std::string& uri, const TransportOptions& options) {
   Parsed p = parse(uri);
-  if (p.scheme == "mcap") throw std::invalid_argument("'" + uri + "': rvc reads bags (bag:, mcap:), it does not write them");
+  // mcap:PATH as an output: verdicts in an MCAP file (bag:PATH names only inputs).
+  if (p.scheme == "mcap") {
+    if (uri.rfind("bag:", 0) == 0)
+      throw std::invalid_argument("'" + uri + "': rvc reads bags (bag:), it writes verdicts to mcap:PATH");
+    return std::make_unique<mcap::McapSink>(p.rest);
+  }
   if (p.scheme == "file") return std::make_unique<FileSink>(p.rest);
   if (p.scheme == "rmw_zenoh") {
 #ifdef RVC_HAVE_ZENOH

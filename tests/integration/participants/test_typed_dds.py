@@ -105,6 +105,9 @@ def types(rvc, tmp_path, monkeypatch):
         time: float64
         property: str
         value: bool
+        stamp: Time_
+        robustness: float64
+        explanation: sequence[str]
 
     return {"Time": Time_, "Deep": Deep_, "Inner": Inner_, "Nothing": Nothing_, "Mixed": Mixed_,
             "Gear": GearReport_, "Verdict": Verdict_}
@@ -274,6 +277,8 @@ def test_typed_verdicts_reach_a_python_subscriber(rvc, tmp_path, types):
         return len(got) >= len(expected)
     wait_for(collect, "the typed verdicts")
     assert [{"time": v.time, "property": v.property, "value": v.value} for v in got] == expected
+    # Boolean verdicts: robustness NaN; stamp: when the verdict was made (a live input: the wall clock)
+    assert all(v.robustness != v.robustness and v.stamp.sec > 1_600_000_000 for v in got)
 
 
 def replay_gear(rvc, trace, domain):
