@@ -15,7 +15,7 @@ import sys
 
 import pytest
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
 TOOL = os.path.join(ROOT, "tools", "rvc-batch", "rvc_batch.py")
 _spec = importlib.util.spec_from_file_location("example_bags", os.path.join(ROOT, "tools", "rvc-batch",
                                                                            "example_bags.py"))
@@ -23,7 +23,6 @@ eb = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(eb)
 
 COUNT, MESSAGES = 200, 20
-pytestmark = pytest.mark.needs_rust  # MCAP bags: rvc's Rust library
 
 
 def batch(rvc, *args, timeout=600):
