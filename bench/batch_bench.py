@@ -88,7 +88,8 @@ def main():
     md = ["| %d bags x %d messages | wall s | bags/s | bags/s without start-up |" % (a.count, a.messages),
           "|---|---|---|---|"]
     for name, wall, tool in rows:
-        md.append("| %s | %.2f | %.1f | %s |" % (name, wall, a.count / wall, "%.1f" % (a.count / tool) if tool else "—"))
+        no_start = "%.1f" % (a.count / tool) if tool else "—"
+        md.append("| %s | %.2f | %.1f | %s |" % (name, wall, a.count / wall, no_start))
     md.append("")
     md.append("Speed-up 2 workers / 1 worker: %.2fx (whole command), %.2fx (without start-up). "
               "Overhead per bag of rvc-batch (1 worker) over plain `rvc check -o sqlite:`: %+.1f ms "

@@ -103,9 +103,23 @@ def check_bag(rvc, bag, check_args, store, out_dir=None, timeout=None):
             name = re.sub(r"[^A-Za-z0-9._-]", "_", bag.strip("/")) + ".jsonl"
             out = open(os.path.join(out_dir, name), "w")
             rec["verdicts"] = out.name
-        p = subprocess.run(cmd, stdout=out, stderr=subprocess.PIPE, text=True, timeout=timeout)
+        p = subprocess.Popen(cmd, stdout=out, stderr=subprocess.PIPE, text=True)
+        try:
+            _, err = p.communicate(timeout=timeout)
+        except subprocess.TimeoutExpired:
+            # SIGTERM first: rvc then ends its run in the store (reason "signal", status 6) with
+            # every row of what it read; SIGKILL only if it does not end within 10 s.
+            p.terminate()
+            try:
+                _, err = p.communicate(timeout=10)
+            except subprocess.TimeoutExpired:
+                p.kill()
+                _, err = p.communicate()
+            rec["exit"] = p.returncode
+            rec["error"] = "still running after %g s (--timeout): stopped" % timeout
+            return rec
         rec["exit"] = p.returncode
-        lines = p.stderr.strip().splitlines()
+        lines = err.strip().splitlines()
         for ln in reversed(lines):
             if ln.startswith("{"):
                 try:
@@ -113,24 +127,24 @@ def check_bag(rvc, bag, check_args, store, out_dir=None, timeout=None):
                     break
                 except ValueError:
                     pass
-        m = re.search(r", run (\S+?):", p.stderr)
+        m = re.search(r", run (\S+?):", err)
         rec["run"] = m.group(1) if m else None
         if p.returncode not in (HELD, VIOLATED):
             msgs = [ln for ln in lines if not ln.startswith("{")]
             rec["error"] = msgs[-1] if msgs else "exit status %d" % p.returncode
-    except subprocess.TimeoutExpired:
-        rec["error"] = "still running after %g s (--timeout): stopped" % timeout
     except OSError as e:
         rec["error"] = "cannot run %s: %s" % (rvc, e)
     finally:
         if out is not subprocess.DEVNULL:
             out.close()
-    rec["seconds"] = time.monotonic() - start
+        rec["seconds"] = time.monotonic() - start
     return rec
 
 
 def failed(rec):
-    return rec["exit"] not in (HELD, VIOLATED)
+    """Not checked to its end: rvc's status says so, or it was stopped (--timeout: then its status,
+    1 after a violation already seen, does not tell)."""
+    return rec["error"] is not None or rec["exit"] not in (HELD, VIOLATED)
 
 
 def make_client(args):
@@ -177,7 +191,8 @@ def parse(argv):
         check_args = []
     ap = argparse.ArgumentParser(prog="rvc-batch", description=__doc__.split("\n\n")[0],
                                  formatter_class=argparse.RawDescriptionHelpFormatter,
-                                 epilog="rvc check's own options go after --, e.g. -- --properties p.yaml --topic /speed")
+                                 epilog="rvc check's own options go after --, "
+                                        "e.g. -- --properties p.yaml --topic /speed")
     ap.add_argument("bags", nargs="+", help="bag files, bag folders, folders to search, @LIST files")
     ap.add_argument("--store", required=True,
                     help="results store for every bag's run: sqlite:PATH or postgresql://... (docs/results.md)")
@@ -262,9 +277,9 @@ def main(argv=None):
             cluster.close()
     seconds = time.monotonic() - start
     records.sort(key=lambda r: bags.index(r["bag"]))
-    held = sum(1 for r in records if r["exit"] == HELD)
-    violated = sum(1 for r in records if r["exit"] == VIOLATED)
-    bad = len(records) - held - violated
+    bad = sum(1 for r in records if failed(r))
+    held = sum(1 for r in records if not failed(r) and r["exit"] == HELD)
+    violated = len(records) - bad - held
     if args.summary:
         with open(args.summary, "w") as f:
             for r in records:

@@ -131,3 +131,14 @@ def test_nothing_to_check_and_bad_paths(rvc, tmp_path):
     r = batch(rvc, str(tmp_path / "empty"), "--store", "results.db", "--", "--spec", "{p}")
     assert r.returncode == 2 and "--store" in r.stderr
     assert not (tmp_path / "x.db").exists()
+
+
+def test_a_bag_past_its_timeout_is_stopped_and_counted(rvc, bags, tmp_path):
+    d, paths, _ = bags
+    # 1 microsecond: no rvc can start, read a bag and end in that time, so every bag is stopped
+    r = batch(rvc, paths[0], paths[1], "--store", "sqlite:%s" % (tmp_path / "t.db"), "--timeout", "0.000001",
+              "--no-progress", "--", "--spec", eb.SPEC)
+    assert r.returncode == 5, r.stderr[-2000:]
+    total = json.loads(r.stdout.strip().splitlines()[-1])
+    assert (total["bags"], total["failed"], total["held"], total["violated"]) == (2, 2, 0, 0)
+    assert r.stderr.count("(--timeout): stopped") == 2
