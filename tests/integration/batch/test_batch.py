@@ -142,3 +142,52 @@ def test_a_bag_past_its_timeout_is_stopped_and_counted(rvc, bags, tmp_path):
     total = json.loads(r.stdout.strip().splitlines()[-1])
     assert (total["bags"], total["failed"], total["held"], total["violated"]) == (2, 2, 0, 0)
     assert r.stderr.count("(--timeout): stopped") == 2
+
+
+@pytest.fixture
+def postgres():
+    """A throwaway PostgreSQL server (scripts/postgres-test.sh: unix socket only) and a psql runner."""
+    import shutil
+    import tempfile
+    pg_bin = os.environ.get("PG_BIN", "/usr/lib/postgresql/15/bin")
+    if not os.access(os.path.join(pg_bin, "postgres"), os.X_OK):
+        pytest.skip("PostgreSQL 15 server not installed (apt-get install postgresql-15)")
+    script = os.path.join(ROOT, "scripts", "postgres-test.sh")
+    d = tempfile.mkdtemp(prefix="rvc-pg-batch-", dir="/tmp")  # the server user must enter it
+    try:
+        r = subprocess.run([script, "start", d], capture_output=True, text=True, timeout=120)
+        assert r.returncode == 0, r.stderr
+        uri = r.stdout.strip()
+
+        def sql(query):
+            p = subprocess.run([os.path.join(pg_bin, "psql"), "-X", "-At", "-v", "ON_ERROR_STOP=1", "-d", uri, "-c",
+                                "SELECT coalesce(json_agg(q), '[]') FROM (%s) q" % query],
+                               capture_output=True, text=True, timeout=30)
+            assert p.returncode == 0, p.stderr
+            return json.loads(p.stdout)
+        yield uri, sql
+    finally:
+        subprocess.run([script, "stop", d], capture_output=True, timeout=120)
+        shutil.rmtree(d, ignore_errors=True)
+
+
+def test_postgresql_store_one_run_per_bag(rvc, bags, postgres, tmp_path):
+    uri, sql = postgres
+    d, paths, _ = bags
+    few = paths[:20]
+    r = batch(rvc, *few, "--store", uri, "--workers", "2", "--no-progress", "--", "--spec", eb.SPEC)
+    assert r.returncode == 1, r.stderr[-3000:]  # bags 0, 5, 10, 15 are violated
+    total = json.loads(r.stdout.strip().splitlines()[-1])
+    assert (total["bags"], total["violated"], total["held"], total["failed"]) == (20, 4, 16, 0)
+    seq_db = tmp_path / "seq.db"
+    for bag in few:
+        subprocess.run([rvc, "check", bag, "--spec", eb.SPEC, "-o", "sqlite:%s" % seq_db], capture_output=True,
+                       timeout=60)
+    want = runs_by_bag(seq_db)
+    runs = sql("SELECT run, inputs, exit_status FROM runs")
+    assert sorted(json.loads(x["inputs"])[0] for x in runs) == sorted(few)
+    for x in runs:
+        bag = json.loads(x["inputs"])[0]
+        verdicts = sql("SELECT property, time, value FROM verdicts WHERE run = '%s' ORDER BY id" % x["run"])
+        got = [(v["property"], float(v["time"]), int(v["value"])) for v in verdicts]
+        assert (x["exit_status"], got) == (want[bag][0], [(p, float(t), int(v)) for p, t, v in want[bag][1]]), bag
