@@ -37,6 +37,9 @@ if rc is None:
     _spec.loader.exec_module(rc)
 
 IMAGE = os.environ.get("RVC_IMAGE", "rvc:latest")
+# The containers run `sleep infinity` and the programs through `sh -c`: the image with a shell
+# (deploy/docker/build.sh makes it beside IMAGE; its rvc is the same binary).
+DEBUG_IMAGE = rc.debug_image(IMAGE)
 
 # docker exec forwards no signals: run the program in its own session and forward TERM/INT to
 # the process inside the container (its pid is written to /tmp/rvcpid.<wrapper pid> there).
@@ -69,8 +72,8 @@ class ContainerSetting(Setting):
         why = rc.docker_available()
         if why:
             return False, why
-        if subprocess.run(["docker", "image", "inspect", IMAGE], capture_output=True).returncode != 0:
-            return False, "image %s not built (deploy/docker/build.sh)" % IMAGE
+        if subprocess.run(["docker", "image", "inspect", DEBUG_IMAGE], capture_output=True).returncode != 0:
+            return False, "image %s not built (deploy/docker/build.sh)" % DEBUG_IMAGE
         why = rc.mode_support().get(cls.mode)
         if why:
             return False, why
@@ -132,7 +135,7 @@ class ContainerSetting(Setting):
             mounts += ["-v", "%s:%s:ro" % (ddsperf, ddsperf)]
         for side in "ab":
             self._docker("run", "-d", "--name", self.names[side], *self._net_args(side), *mounts,
-                         "--entrypoint", "sleep", IMAGE, "infinity")
+                         "--entrypoint", "sleep", DEBUG_IMAGE, "infinity")
 
     def __exit__(self, *exc):
         for side in "ab":

@@ -47,6 +47,14 @@ POOL = ipaddress.ip_network("172.28.0.0/17")  # docker-setup.sh keeps dockerd's 
 ZN = "--no-multicast-scouting"
 
 
+
+def debug_image(image):
+    """The image with a shell beside IMAGE (deploy/docker/build.sh makes both): rvc:latest ->
+    rvc:latest-debug. RVC_DEBUG_IMAGE overrides. The runtime image has no shell and no sleep."""
+    if os.environ.get("RVC_DEBUG_IMAGE"):
+        return os.environ["RVC_DEBUG_IMAGE"]
+    return image + "-debug" if ":" in image.rsplit("/", 1)[-1] else image + ":latest-debug"
+
 class Unsupported(Exception):
     """This machine cannot run the requested mode (the message says why)."""
 
@@ -192,7 +200,7 @@ class Deployment:
     def plan(self, subnet=None):
         """Computes every compose variable for this (architecture, transport, mode)."""
         svc = ("monitor", "publisher", "router", "bridge", "app", "sync")
-        env = {"RVC_IMAGE": self.image, "RVC_WAIT_TIMEOUT": str(self.wait_timeout),
+        env = {"RVC_IMAGE": self.image, "RVC_DEBUG_IMAGE": debug_image(self.image), "RVC_WAIT_TIMEOUT": str(self.wait_timeout),
                "RVC_MONITOR_FLAGS": self.monitor_flags, "RVC_MONITOR_OUTPUT": self.monitor_output,
                "RVC_REPLAY_FLAGS": self.replay_flags}
         if self.trace:

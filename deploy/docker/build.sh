@@ -6,6 +6,10 @@
 #
 #   deploy/docker/build.sh [--tag IMAGE] [--network host] [--no-cache] [--jobs N] [--zenoh-lib FILE]
 #
+# Makes two images from the same layers: IMAGE (the runtime: FROM scratch, no shell) and
+# IMAGE-debug (tag + "-debug", e.g. rvc:latest-debug: the same plus sh, sleep, cat, date, for
+# scripts that run several commands in one container).
+#
 # --zenoh-lib FILE: use FILE (librvc_zenoh.a from a host build of the same checkout, e.g.
 # build/release/cargo-target/release/librvc_zenoh.a) instead of compiling the Zenoh crate in the
 # image; the host must be Debian bookworm like the image. The test tier does this (one compile of
@@ -13,10 +17,12 @@
 #
 # Environment: RVC_IMAGE (default rvc:latest), RVC_DOCKER (docker client to use),
 # RVC_DOCKER_BUILDER=buildkit|legacy (force one). Prints one JSON line at the end:
-#   {"image":"rvc:latest","builder":"buildkit","seconds":312.4,"size_bytes":96123456}
+#   {"image":"rvc:latest","builder":"buildkit","seconds":312.4,"size_bytes":35123456,
+#    "debug_image":"rvc:latest-debug","debug_size_bytes":35456789}
 set -euo pipefail
 ROOT=$(cd "$(dirname "$0")/../.." && pwd)
 IMAGE=${RVC_IMAGE:-rvc:latest}
+debug_tag() { case "${1##*/}" in *:*) echo "$1-debug" ;; *) echo "$1:latest-debug" ;; esac; }
 JOBS=2
 ZENOH_LIB=""
 extra=()
@@ -27,7 +33,7 @@ while [ $# -gt 0 ]; do
     --no-cache) extra+=(--no-cache); shift ;;
     --jobs) JOBS=$2; shift 2 ;;
     --zenoh-lib) ZENOH_LIB=$2; shift 2 ;;
-    -h|--help) sed -n '2,17p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,22p' "$0"; exit 0 ;;
     *) echo "build.sh: unknown argument $1" >&2; exit 2 ;;
   esac
 done
@@ -64,14 +70,21 @@ if [ -n "$ZENOH_LIB" ]; then
 fi
 start=$(date +%s.%N)
 echo "build.sh: $builder builder ($client), image $IMAGE" >&2
-if [ "$builder" = buildkit ]; then
-  DOCKER_BUILDKIT=1 "$client" build --progress=plain -f deploy/docker/Dockerfile \
-    --build-arg JOBS="$JOBS" -t "$IMAGE" "${extra[@]}" .
-else
-  sed -E '/^ *#/!s/--mount=[^ ]+ *//g; /^ *\\$/d' deploy/docker/Dockerfile |
-    DOCKER_BUILDKIT=0 "$client" build -f - --build-arg JOBS="$JOBS" -t "$IMAGE" "${extra[@]}" .
-fi
+DEBUG_IMAGE=$(debug_tag "$IMAGE")
+for target in runtime debug; do
+  tag=$IMAGE
+  [ "$target" = debug ] && tag=$DEBUG_IMAGE
+  if [ "$builder" = buildkit ]; then
+    DOCKER_BUILDKIT=1 "$client" build --progress=plain -f deploy/docker/Dockerfile --target "$target" \
+      --build-arg JOBS="$JOBS" -t "$tag" "${extra[@]}" .
+  else
+    sed -E '/^ *#/!s/--mount=[^ ]+ *//g; /^ *\\$/d' deploy/docker/Dockerfile |
+      DOCKER_BUILDKIT=0 "$client" build -f - --target "$target" --build-arg JOBS="$JOBS" -t "$tag" "${extra[@]}" .
+  fi
+done
 end=$(date +%s.%N)
 size=$("$client" image inspect -f '{{.Size}}' "$IMAGE")
-printf '{"image":"%s","builder":"%s","zenoh":"%s","seconds":%.1f,"size_bytes":%s}\n' \
-  "$IMAGE" "$builder" "$zenoh" "$(echo "$end - $start" | bc -l 2>/dev/null || python3 -c "print($end-$start)")" "$size"
+dsize=$("$client" image inspect -f '{{.Size}}' "$DEBUG_IMAGE")
+printf '{"image":"%s","builder":"%s","zenoh":"%s","seconds":%.1f,"size_bytes":%s,"debug_image":"%s","debug_size_bytes":%s}\n' \
+  "$IMAGE" "$builder" "$zenoh" "$(echo "$end - $start" | bc -l 2>/dev/null || python3 -c "print($end-$start)")" "$size" \
+  "$DEBUG_IMAGE" "$dsize"

@@ -107,7 +107,10 @@ class Deployment:
         flags = ["--properties", "/data/properties.yaml", "--sync", "merge", "--max-delay", str(self.max_delay),
                  "--idle-timeout", str(self.idle), "--output", "file:/out/verdicts.jsonl",
                  "--stats-output", "file:/out/monitor-stats.json"] + (["--dense"] if self.dense else [])
-        self.env = dict(os.environ, RVC_IMAGE=self.image, AW_DATA=self.data, AW_OUT=self.out, AW_NET_A=self.net_a,
+        # the vehicle runs a shell script: it uses the image with a shell (deploy/docker/build.sh)
+        debug = os.environ.get("RVC_DEBUG_IMAGE") or (
+            self.image + "-debug" if ":" in self.image.rsplit("/", 1)[-1] else self.image + ":latest-debug")
+        self.env = dict(os.environ, RVC_IMAGE=self.image, RVC_DEBUG_IMAGE=debug, AW_DATA=self.data, AW_OUT=self.out, AW_NET_A=self.net_a,
                         AW_NET_B=self.net_b, AW_INPUTS_DDS=" ".join(dds_in), AW_INPUTS_ZENOH=" ".join(zenoh_in),
                         AW_BRIDGE_ROUTES=" ".join(routes + bridge_types), AW_MONITOR_FLAGS=" ".join(flags))
 
