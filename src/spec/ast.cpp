@@ -163,7 +163,8 @@ std::string FieldTest::to_string() const {
     // {a == (b)}: a bare word after == is a string (or a message constant), so
     // a field there is written in parentheses.
     std::string right = spec::to_string(*rhs);
-    if (rhs->kind == Expr::Kind::Field && (op == Op::Eq || op == Op::Ne)) right = "(" + right + ")";
+    // A quoted key there would read as a string too: {a < ("k y")}.
+    if (rhs->kind == Expr::Kind::Field && (op == Op::Eq || op == Op::Ne || right[0] == '"')) right = "(" + right + ")";
     return spec::to_string(*lhs) + comparison_text(op) + right;
   }
   std::string k = key();
