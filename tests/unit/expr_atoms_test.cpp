@@ -188,6 +188,20 @@ TEST(ExprValues, MarginsAreTheDifferenceOfTheSides) {
   EXPECT_EQ(m, (std::vector<double>{-std::numeric_limits<double>::infinity()}));
 }
 
+TEST(ExprValues, ExplainNamesTheNumbers) {
+  std::vector<std::vector<std::string>> why;
+  runtime::PipelineOptions po;
+  po.explain = true;
+  runtime::Pipeline p({{"p", "historically({abs(a - b) < 0.5})"}}, po, [&](const engine::Verdict& v) {
+    if (v.explanation) why.push_back(*v.explanation);
+  });
+  p.feed(R"({"a": 1, "b": 1.25})", 1);
+  p.feed(R"({"a": 1, "b": 3})", 2);
+  ASSERT_EQ(why.size(), 1u);
+  ASSERT_EQ(why[0].size(), 2u);
+  EXPECT_EQ(why[0][1], "{abs((a - b)) < 0.5} is false at step 1 (a = 1, b = 3)");
+}
+
 // ---- rise and fall ----
 
 TEST(Edges, RiseAndFallInDiscreteTime) {

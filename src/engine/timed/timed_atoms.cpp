@@ -1,5 +1,6 @@
 #include "engine/timed/timed_atoms.hpp"
 
+#include <charconv>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -54,7 +55,7 @@ TimedAtoms::TimedAtoms(AtomTable& atoms, const std::vector<std::string>& inputs,
         const int hidden = atoms.intern(field);
         for (size_t k = 0; k < leaves_.size(); ++k)
           if (leaves_[k].id == hidden) return static_cast<int>(k);
-        leaves_.push_back({hidden});
+        leaves_.push_back({hidden, field.key()});
         return static_cast<int>(leaves_.size() - 1);
       };
       ExprAtom e{static_cast<int>(id), test.op, CompiledExpr(*test.lhs, leaf_of), CompiledExpr(*test.rhs, leaf_of), {}};
@@ -210,6 +211,25 @@ bool TimedAtoms::holds(const Atom& a) const {
     }
   }
   return compare(a.op, measure(a), a.bound);
+}
+
+std::string TimedAtoms::describe(int atom_id) const {
+  std::string out;
+  for (const ExprAtom& e : exprs_) {
+    if (e.id != atom_id) continue;
+    for (int k : e.leaves) {
+      const Leaf& l = leaves_[static_cast<size_t>(k)];
+      out += (out.empty() ? "" : ", ") + l.key;
+      if (!l.seen) {
+        out += ": no number yet";
+        continue;
+      }
+      char buf[32];
+      const auto r = std::to_chars(buf, buf + sizeof buf, l.number);
+      out += " = " + std::string(buf, r.ptr);
+    }
+  }
+  return out;
 }
 
 void TimedAtoms::write(uint8_t* values) const {

@@ -57,6 +57,11 @@ class TimedAtoms {
   void write(uint8_t* values) const;
   void write_margins(double* margins) const;
 
+  // --explain: the numbers an expression atom computed with, "a = 1, b = 2.5"
+  // ("b: no number yet"); "" for any other atom.
+  std::string describe(int atom_id) const;
+  bool has_expressions() const { return !exprs_.empty(); }
+
  private:
   struct Atom {
     int id;               // in the atom table
@@ -91,6 +96,7 @@ class TimedAtoms {
   };
   struct Leaf {
     int id;  // the hidden Value test
+    std::string key;  // the field, as written
     double number = 0;
     bool seen = false;
   };
