@@ -188,6 +188,19 @@ TEST(ExprValues, MarginsAreTheDifferenceOfTheSides) {
   EXPECT_EQ(m, (std::vector<double>{-std::numeric_limits<double>::infinity()}));
 }
 
+TEST(ExprValues, DenseTimeChangesOnlyAtMessages) {
+  Verdicts out;
+  runtime::PipelineOptions po;
+  po.model = engine::TimeModel::Dense;
+  runtime::Pipeline p({{"p", "once[0:1]{a - b > 0}"}}, po, [&](const engine::Verdict& v) { out.emplace_back(v.time, v.value); });
+  uint64_t n = 0;
+  // a - b: -1 on [0, 1.5), 1 on [1.5, 2) (b held), -2 from 2: once[0:1] holds on [1.5, 3).
+  for (const char* l : {R"({"time": 0, "a": 1, "b": 2})", R"({"time": 1.5, "a": 3})", R"({"time": 2, "b": 5})",
+                        R"({"time": 4, "a": 0})"})
+    p.feed(l, ++n);
+  EXPECT_EQ(out, (Verdicts{{0, false}, {1.5, true}, {3, false}}));
+}
+
 TEST(ExprValues, ExplainNamesTheNumbers) {
   std::vector<std::vector<std::string>> why;
   runtime::PipelineOptions po;
