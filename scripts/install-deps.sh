@@ -66,11 +66,11 @@ fi
 # Zenoh binding, CycloneDDS's Python binding, rosbags (ROS 2 CDR and rosbag2 bags),
 # Foxglove's MCAP writer with its chunk compressions (zstd, lz4), pytest; rvc-batch's engine
 # (Dask's distributed scheduler) and progress bar (tqdm); kubernetes-validate (the offline check of
-# deploy/k8s against the Kubernetes API schemas).
+# deploy/k8s against the Kubernetes API schemas); RTAMT (the STL oracle).
 PY=${PYTHON:-python3}
 PIP_PACKAGES=(pytest "reelay==25.0.0" "eclipse-zenoh==1.10.2" "cyclonedds==11.0.1" "rosbags==0.11.9" matplotlib
   "mcap==1.6.0" "zstandard==0.25.0" "lz4==4.4.5" "dask==2026.8.0" "distributed==2026.8.0" "tqdm==4.70.1"
-  "kubernetes-validate==1.37.0")
+  "kubernetes-validate==1.37.0" "rtamt==0.4.10")
 if ! "$PY" - "${PIP_PACKAGES[@]}" <<'PYEOF' 2>/dev/null
 import sys
 from importlib.metadata import version, PackageNotFoundError

@@ -24,6 +24,7 @@ namespace {
 const char* expected_for(const spec::FieldTest& t) {
   if (t.op == FOp::Truthy) return "a Boolean or number";
   if (t.op == FOp::Bind) return "a string, number or Boolean to bind";
+  if (t.op == FOp::Value) return "a number (or a Boolean, 1 or 0)";
   switch (t.value.kind) {
     case spec::Literal::Kind::Bool: return "a Boolean";
     case spec::Literal::Kind::Number: return "a number";
@@ -35,6 +36,9 @@ const char* expected_for(const spec::FieldTest& t) {
 }  // namespace
 
 std::string wrong_type_problem(const spec::FieldTest& t, ValueKind kind) {
+  if (t.op == FOp::Value)  // a hidden test: name what reads it
+    return "field \"" + t.key() + "\" is " + value_kind_name(kind) + ", but an expression reads it, which needs " +
+           expected_for(t);
   return "field \"" + t.key() + "\" is " + value_kind_name(kind) + ", but {" + t.to_string() + "} needs " +
          expected_for(t);
 }
@@ -44,6 +48,7 @@ int evaluate_test(const spec::FieldTest& t, const FieldValue& v) {
   const bool number = v.kind == ValueKind::Number;
   switch (t.op) {
     case FOp::Present: return 1;
+    case FOp::Value: return number || v.kind == ValueKind::Bool ? 1 : -1;  // null: no value (as missing)
     case FOp::Bind:  // binds scalars; null is no value (as a missing field)
       return v.kind == ValueKind::String || v.kind == ValueKind::Number || v.kind == ValueKind::Bool ? 1 : -1;
     case FOp::Truthy:
@@ -77,6 +82,10 @@ double test_margin(const spec::FieldTest& t, const FieldValue& v) {
       if (v.kind == ValueKind::Number) return v.d;
       if (v.kind == ValueKind::Null) return 0;
       break;
+    case FOp::Value:  // the number itself, what an expression computes with
+      if (v.kind == ValueKind::Bool) return v.b ? 1 : 0;
+      if (v.kind == ValueKind::Number) return v.d;
+      return std::numeric_limits<double>::quiet_NaN();
     case FOp::Lt:
     case FOp::Le:
       if (number) return t.value.number - v.d;

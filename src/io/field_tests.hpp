@@ -60,7 +60,8 @@ int evaluate_test(const spec::FieldTest& test, const FieldValue& value);
 // The test's robustness (Reelay's quantitative semantics): {x > c} and
 // {x >= c}: x - c; {x < c}, {x <= c}: c - x; {x == c}: -|x - c|; {x != c}:
 // |x - c|; a Boolean field {p}: 1 or 0; a number {x}: x; string and Boolean
-// equality, presence: +inf or -inf. NaN: a type the test cannot use (as
+// equality, presence: +inf or -inf; Value (an expression's field): the
+// number, a Boolean 1 or 0. NaN: a type the test cannot use (as
 // evaluate_test's -1).
 double test_margin(const spec::FieldTest& test, const FieldValue& value);
 

@@ -91,7 +91,12 @@ bool needs_margins(const PipelineOptions& o, const engine::timed::TimedAtoms* ti
 
 Pipeline::Pipeline(const std::vector<engine::PropertySpec>& properties, const PipelineOptions& options,
                    engine::VerdictCallback on_verdict)
-    : checker_(build(properties, with_defaults(options), std::move(on_verdict))),
+    : checker_(build(properties, with_defaults(options),
+                     options.explain && options.model == engine::TimeModel::Discrete
+                         ? engine::VerdictCallback([this, send = std::move(on_verdict)](const engine::Verdict& v) {
+                             send_explained(send, v);
+                           })
+                         : std::move(on_verdict))),
       timed_(make_timed(checker_)),
       options_(with_defaults(options)),
       atoms_(checker_.atoms()),
@@ -113,6 +118,22 @@ Pipeline::Pipeline(const std::vector<engine::PropertySpec>& properties, const Pi
     checker_.set_value_names([this](uint32_t id) {
       return typed_ ? typed_->bound_values().json(id) : decoder_.bound_values().json(id);
     });
+}
+
+void Pipeline::send_explained(const engine::VerdictCallback& send, const engine::Verdict& v) const {
+  if (!send) return;
+  if (!v.explanation || !timed_ || !timed_->has_expressions()) return send(v);
+  std::vector<std::string> why = *v.explanation;
+  const std::string now = " at step " + std::to_string(static_cast<uint64_t>(v.time));
+  for (size_t id = 0; id < atoms_.size(); ++id) {
+    if (!atoms_.tests()[id].is_expr()) continue;
+    const std::string atom = "{" + atoms_.tests()[id].to_string() + "} is ";
+    for (std::string& s : why)
+      if (s.find(atom) != std::string::npos && s.size() >= now.size() &&
+          s.compare(s.size() - now.size(), now.size(), now) == 0)
+        s += " (" + timed_->describe(static_cast<int>(id)) + ")";
+  }
+  send(engine::Verdict{v.property, v.time, v.value, v.robust, v.robustness, &why});
 }
 
 void Pipeline::make_typed_decoder() {

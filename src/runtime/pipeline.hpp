@@ -129,6 +129,9 @@ class Pipeline final : public io::JsonlHandler, public Feed {
   }
 
  private:
+  // --explain (discrete): an expression atom's sentence about the current
+  // step also names the numbers it computed with, then the verdict goes on.
+  void send_explained(const engine::VerdictCallback& send, const engine::Verdict& v) const;
   // Ticks run only on a checking dense pipeline after its first message:
   // before it there is no held value, and the timeline's start is 0.
   bool ticking() const {

@@ -90,7 +90,22 @@ void check_paths(const std::vector<engine::PropertySpec>& properties, const std:
         throw spec::SpecError("in property '" + p.name + "': with several inputs, say whose " + n.test.path[0] +
                                   " it is: {input." + n.test.path[0] + " ...} (inputs: " + names_of(inputs) + ")",
                               p.spec, n.test.column);
-      if (n.op == spec::Op::Test) {
+      if (n.op == spec::Op::Test && n.test.is_expr()) {  // each field of an expression names its input
+        std::vector<const spec::Expr*> fields;
+        spec::expr_fields(*n.test.lhs, fields);
+        spec::expr_fields(*n.test.rhs, fields);
+        for (const spec::Expr* f : fields) {
+          bool known = false;
+          for (const auto& i : inputs) known = known || f->path[0] == i.name;
+          if (known && f->path.size() > 1) continue;
+          spec::FieldTest named;
+          named.path = f->path;
+          throw spec::SpecError("in property '" + p.name + "': field '" + named.key() +
+                                    "' names no input's field; with several inputs a field is input.field (inputs: " +
+                                    names_of(inputs) + ")",
+                                p.spec, f->column);
+        }
+      } else if (n.op == spec::Op::Test) {
         const auto& path = n.test.path;
         bool known = false;
         for (const auto& i : inputs) known = known || path[0] == i.name;

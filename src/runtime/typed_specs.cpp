@@ -73,6 +73,10 @@ std::optional<spec::Literal> check_test(const spec::FieldTest& test, const Messa
   }
   const bool numeric = value.array == ArrayKind::None && value.prim != Prim::Message && value.prim != Prim::String &&
                        value.prim != Prim::WString;
+  if (test.op == spec::FieldTest::Op::Value && !numeric)  // a field of an expression (issue 29)
+    throw spec::SpecError("field '" + test.key() + "' is " + value.to_string() +
+                              ": an expression computes with numbers (and Booleans, as 1 or 0)",
+                          text, test.column);
   if (test.op == spec::FieldTest::Op::Bind && (value.array != ArrayKind::None || value.prim == Prim::Message))
     throw spec::SpecError("field '" + test.key() + "' is " + value.to_string() +
                               ": a reference binds a string, number or Boolean field",
@@ -110,6 +114,21 @@ void bind_message_type(engine::AtomTable& atoms, const std::vector<engine::Prope
       std::function<void(const spec::Node&)> walk = [&](const spec::Node& n) {
         if (n.op == spec::Op::Test) {
           spec::FieldTest test = n.test;
+          if (test.is_expr()) {  // each field it reads, as a number, at the field's column
+            std::vector<const spec::Expr*> fields;
+            spec::expr_fields(*test.lhs, fields);
+            spec::expr_fields(*test.rhs, fields);
+            for (const spec::Expr* f : fields) {
+              spec::FieldTest leaf;
+              leaf.path = f->path;
+              leaf.op = spec::FieldTest::Op::Value;
+              leaf.column = f->column;
+              if (!input.empty() && (leaf.path.size() < 2 || leaf.path[0] != input)) continue;
+              if (!input.empty()) leaf.path.erase(leaf.path.begin());
+              check_test(leaf, type, dense && input.empty(), time_field, p.spec);
+            }
+            return;
+          }
           if (test.is_timed()) {
             // A timing atom reads no field; an aggregate's field must exist.
             if (test.timed.kind != spec::Timed::Kind::Aggregate || test.timed.of_arrivals) test.path.clear();

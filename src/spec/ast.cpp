@@ -57,7 +57,56 @@ std::string bounds_text(const Bounds& b) {
   return out + "]";
 }
 
+std::string path_text(const std::vector<std::string>& path) {
+  std::string out;
+  for (size_t i = 0; i < path.size(); ++i) {
+    if (is_index_part(path[i])) out += path[i];
+    else out.append(i ? "." : "").append(quote_if_needed(path[i]));
+  }
+  return out;
+}
+
+const char* comparison_text(FieldTest::Op op) {
+  switch (op) {
+    case FieldTest::Op::Eq: return " == ";
+    case FieldTest::Op::Ne: return " != ";
+    case FieldTest::Op::Lt: return " < ";
+    case FieldTest::Op::Le: return " <= ";
+    case FieldTest::Op::Gt: return " > ";
+    case FieldTest::Op::Ge: return " >= ";
+    default: return " ? ";
+  }
+}
+
 }  // namespace
+
+std::string to_string(const Expr& e) {
+  using K = Expr::Kind;
+  auto arg = [&](size_t i) { return to_string(*e.args[i]); };
+  switch (e.kind) {
+    case K::Number: return number_text(e.number);
+    case K::Field: return path_text(e.path);
+    case K::Neg: return "(-" + arg(0) + ")";
+    case K::Add: return "(" + arg(0) + " + " + arg(1) + ")";
+    case K::Sub: return "(" + arg(0) + " - " + arg(1) + ")";
+    case K::Mul: return "(" + arg(0) + " * " + arg(1) + ")";
+    case K::Div: return "(" + arg(0) + " / " + arg(1) + ")";
+    case K::Abs: return "abs(" + arg(0) + ")";
+    case K::Min: return "min(" + arg(0) + ", " + arg(1) + ")";
+    case K::Max: return "max(" + arg(0) + ", " + arg(1) + ")";
+  }
+  return "?";
+}
+
+void expr_fields(const Expr& e, std::vector<const Expr*>& out) {
+  if (e.kind == Expr::Kind::Field) {
+    for (const Expr* f : out)
+      if (f->path == e.path) return;
+    out.push_back(&e);
+    return;
+  }
+  for (const auto& a : e.args) expr_fields(*a, out);
+}
 
 bool is_index_part(const std::string& part) {
   if (part.size() < 3 || part.front() != '[' || part.back() != ']') return false;
@@ -110,12 +159,21 @@ std::string FieldTest::key() const {
 }
 
 std::string FieldTest::to_string() const {
+  if (is_expr()) {
+    // {a == (b)}: a bare word after == is a string (or a message constant), so
+    // a field there is written in parentheses.
+    std::string right = spec::to_string(*rhs);
+    // A quoted key there would read as a string too: {a < ("k y")}.
+    if (rhs->kind == Expr::Kind::Field && (op == Op::Eq || op == Op::Ne || right[0] == '"')) right = "(" + right + ")";
+    return spec::to_string(*lhs) + comparison_text(op) + right;
+  }
   std::string k = key();
   if (timed.kind == Timed::Kind::Aggregate) k = std::string(func_name(timed.func)) + bounds_text(timed.window) + "(" + k + ")";
   switch (op) {
     case Op::Truthy: return k;
     case Op::Present: return k + ": *";
     case Op::Bind: return k + ": *" + variable;
+    case Op::Value: return k + " as a number";  // hidden (no syntax): an expression's field
     case Op::Eq: return k + " == " + literal_text(value);
     case Op::Ne: return k + " != " + literal_text(value);
     case Op::Lt: return k + " < " + literal_text(value);

@@ -46,7 +46,9 @@ uint32_t index_of_part(const std::string& part);  // "[12]" -> 12
 //   {count[0:1](steer.@arrived) >= 20}, {avg[0:2](steer.speed) > 3}
 // The input name is left out with one unnamed input ({@age <= 0.2}).
 struct Timed {
-  enum class Kind : uint8_t { None, Arrived, Age, Latency, Aggregate };
+  // Expr: an arithmetic comparison ({abs(a.x - b.x) < 0.05}; FieldTest::lhs, rhs),
+  // valued by the runtime like the others from its fields' committed values.
+  enum class Kind : uint8_t { None, Arrived, Age, Latency, Aggregate, Expr };
   enum class Func : uint8_t { Count, Sum, Avg, Min, Max };
   Kind kind = Kind::None;
   Func func = Func::Count;  // Aggregate
@@ -56,11 +58,30 @@ struct Timed {
 const char* timed_name(Timed::Kind kind);  // "@age"
 const char* func_name(Timed::Func func);   // "count"
 
+// An arithmetic expression over fields and numbers (issue 29): one side of
+// {abs(steer.angle - cmd.angle) < 0.05}, {a.x + 2 * b.x >= c}, {min(x, y) > 0}.
+// Evaluated in double (engine/timed/expr_atoms.hpp); the tree is shared
+// between copies of its test, never changed after parsing.
+struct Expr {
+  enum class Kind : uint8_t { Number, Field, Neg, Add, Sub, Mul, Div, Abs, Min, Max };
+  Kind kind = Kind::Number;
+  double number = 0;               // Number (a double: expressions compute in double)
+  std::vector<std::string> path;   // Field: as FieldTest::path
+  std::vector<std::shared_ptr<const Expr>> args;  // operands (Neg, Abs: one; the rest: two)
+  int column = 0;                  // where it starts in the spec text
+};
+using ExprPtr = std::shared_ptr<const Expr>;
+std::string to_string(const Expr& e);  // canonical text, round-trips through the parser
+// The fields an expression reads, each once, in the order written.
+void expr_fields(const Expr& e, std::vector<const Expr*>& out);
+
 // One test on one field: {p}, {p: false}, {x > 3}, {mode: "a"}, {m: *}, {id: *x}.
 // Timing atoms and aggregates are tests too (see Timed): `path` names the
 // input then the atom ({"steer", "@age"}), or an aggregate's field.
 struct FieldTest {
-  enum class Op { Truthy, Eq, Ne, Lt, Le, Gt, Ge, Present, Bind };
+  // Value: the field's number, for an expression (a hidden test the runtime
+  // adds for each field an Expr reads; a Boolean counts 1 or 0).
+  enum class Op { Truthy, Eq, Ne, Lt, Le, Gt, Ge, Present, Bind, Value };
   // "a.b" -> {"a", "b"}; quoted keys stay whole; an array element is its own
   // part: "ranges[0].x" -> {"ranges", "[0]", "x"} (see is_index_part).
   std::vector<std::string> path;
@@ -69,8 +90,10 @@ struct FieldTest {
   std::string variable;           // for Bind ({id: *x})
   int column = 0;
   Timed timed;                    // kind None: an ordinary field test
+  ExprPtr lhs, rhs;               // Timed::Kind::Expr: `lhs op rhs` (path is empty)
 
   bool is_timed() const { return timed.kind != Timed::Kind::None; }
+  bool is_expr() const { return timed.kind == Timed::Kind::Expr; }
   // The input a timing atom or aggregate is about ("" with one unnamed input).
   std::string timed_input() const;
   std::string key() const;        // path joined with '.'

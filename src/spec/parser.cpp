@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdint>
 #include <exception>
+#include <memory>
 #include <string>
 #include <system_error>
 #include <utility>
@@ -250,6 +251,7 @@ class Parser {
   NodePtr parse_unary() {
     skip_ws();
     size_t at = pos_;
+    if (NodePtr edge = parse_edge_opt()) return edge;
     Op op;
     if (accept_symbol("!") || accept_word("not")) op = Op::Not;
     else if (accept_word("pre") || accept_word("Y")) op = Op::Pre;
@@ -263,6 +265,59 @@ class Parser {
       fail("'pre' takes no time bounds: it always looks exactly one step back", at);
     node->left = parse_unary();
     return node;
+  }
+
+  // ---- rise and fall (issue 29), as RTAMT defines them in discrete time ----
+  //   rise φ = φ and not pre φ              (step 0: φ, the step before reads false)
+  //   fall φ = not φ and not pre (not φ)    (step 0: not φ, the step before reads true)
+  // Written out with `pre`, so every monitor (Boolean, robustness, data
+  // references, --explain) has them with nothing of its own; the robustness
+  // is RTAMT's min(φ, -previous φ) / min(previous φ, -φ).
+  static constexpr size_t kMaxEdgeCopies = 100000;  // nodes copied for rise/fall in one spec
+  size_t edge_copies_ = 0;
+
+  NodePtr copy_of(const Node& n) {
+    if (++edge_copies_ > kMaxEdgeCopies)
+      throw SpecError("rise/fall nested too deeply: each one copies its operand, and this spec would copy more than " +
+                          std::to_string(kMaxEdgeCopies) + " operators",
+                      s_, n.column > 0 ? n.column : 1);
+    auto c = std::make_unique<Node>();
+    c->op = n.op;
+    c->column = n.column;
+    c->bounds = n.bounds;
+    c->test = n.test;
+    c->variables = n.variables;
+    if (n.left) c->left = copy_of(*n.left);
+    if (n.right) c->right = copy_of(*n.right);
+    return c;
+  }
+  NodePtr unary(Op op, NodePtr operand, size_t at) {
+    auto n = make(op, at);
+    n->left = std::move(operand);
+    return n;
+  }
+
+  NodePtr parse_edge_opt() {
+    const size_t at = pos_;
+    const bool rise = peek_word("rise");
+    if (!rise && !peek_word("fall")) return nullptr;
+    if (opt_.dense)
+      fail(std::string(rise ? "rise" : "fall") +
+               " marks an instant, and in dense time a signal holds values over intervals (RTAMT's dense monitors "
+               "have no rise/fall either): check it in discrete time",
+           at);
+    pos_ += 4;
+    Nest nest(*this, at);
+    NodePtr operand = parse_unary();
+    NodePtr before = copy_of(*operand);
+    if (!rise) {
+      operand = unary(Op::Not, std::move(operand), at);
+      before = unary(Op::Not, std::move(before), at);
+    }
+    auto edge = make(Op::And, at);
+    edge->left = std::move(operand);
+    edge->right = unary(Op::Not, unary(Op::Pre, std::move(before), at), at);
+    return edge;
   }
 
   NodePtr parse_primary() {
@@ -529,12 +584,16 @@ class Parser {
     FieldTest t;
     skip_ws();
     t.column = column(pos_);
+    expr_nodes_ = 0;
     Timed::Func func;
     size_t length = 0;
-    if (peek_aggregate(func, length)) return parse_aggregate(std::move(t), func, length);
+    if (peek_aggregate(func, length) && !peek_function(pos_)) return parse_aggregate(std::move(t), func, length);
+    if (starts_expression()) return finish_expression_test(std::move(t), parse_expr());
+    const size_t path_at = pos_;
     const size_t atom_at = parse_path(t);
     if (t.is_timed()) return finish_timing_atom(std::move(t), atom_at);
     skip_ws();
+    if (is_arithmetic(peek())) return finish_expression_test(std::move(t), parse_expr(field_expr(t.path, path_at)));
     size_t op_at = pos_;
     using FOp = FieldTest::Op;
     if (peek() == ',' || peek() == '}') { t.op = FOp::Truthy; return t; }
@@ -565,11 +624,234 @@ class Parser {
     else if (accept_symbol(">")) t.op = FOp::Gt;
     else fail("expected ':', a comparison (< <= > >= == !=), ',' or '}' after field '" + t.key() + "'", op_at);
     skip_ws();
+    if (rhs_is_expression(t.op)) {  // {a.x < b.x}, {x > 2 * y}
+      ExprPtr lhs = field_expr(t.path, path_at);
+      t.path.clear();
+      return make_expression_test(std::move(t), std::move(lhs), parse_expr());
+    }
     size_t lit_at = pos_;
     t.value = parse_literal(/*allow_bare_word=*/true);
     bool ordering = t.op == FOp::Lt || t.op == FOp::Le || t.op == FOp::Gt || t.op == FOp::Ge;
     if (ordering && t.value.kind != Literal::Kind::Number)
       fail("'<', '<=', '>', '>=' compare numbers; this is not a number", lit_at);
+    return t;
+  }
+
+  // ---- Arithmetic in atoms (issue 29) ----
+  //   expr    := term (('+' | '-') term)*
+  //   term    := unary (('*' | '/') unary)*
+  //   unary   := '-' unary | primary
+  //   primary := number | path | '(' expr ')' | abs(expr) | min(expr, expr) | max(expr, expr)
+  // min/max with one argument stay the aggregates over the whole past.
+  static bool is_arithmetic(char c) { return c == '+' || c == '-' || c == '*' || c == '/'; }
+
+  // At `at`: "abs(", or "min(" / "max(" with two arguments (a ',' at the top
+  // level of its parentheses).
+  bool peek_function(size_t at) const {
+    for (const char* name : {"abs", "min", "max"}) {
+      const size_t n = std::char_traits<char>::length(name);
+      if (s_.compare(at, n, name) != 0 || at + n >= s_.size() || s_[at + n] != '(') continue;
+      if (name[0] == 'a') return true;
+      int depth = 0;
+      for (size_t i = at + n; i < s_.size(); ++i) {
+        const char c = s_[i];
+        if (c == '"') {  // a quoted key: skip it
+          for (++i; i < s_.size() && s_[i] != '"'; ++i)
+            if (s_[i] == '\\') ++i;
+        } else if (c == '(' || c == '[') {
+          ++depth;
+        } else if (c == ')' || c == ']') {
+          if (--depth == 0) return false;
+        } else if (c == ',' && depth == 1) {
+          return true;
+        } else if (c == '}' || c == '{') {
+          return false;
+        }
+      }
+      return false;
+    }
+    return false;
+  }
+
+  // A test that starts with something no field path starts with: {-x > 1},
+  // {(a + b) > 1}, {3 < x}, {abs(x - y) < 0.1}.
+  bool starts_expression() const {
+    const char c = peek();
+    return c == '(' || c == '-' || c == '+' || c == '.' || std::isdigit(static_cast<unsigned char>(c)) ||
+           peek_function(pos_);
+  }
+
+  // After a comparison: is its right side an expression rather than a
+  // literal? A bare word after '==' / '!=' stays a string or a message
+  // constant ({gear == REVERSE}); after '<' .. '>=' it is a field.
+  bool rhs_is_expression(FieldTest::Op op) const {
+    const bool ordering = op != FieldTest::Op::Eq && op != FieldTest::Op::Ne;
+    size_t i = pos_;
+    const char c = peek();
+    auto next_is_arithmetic = [&](size_t j) {
+      while (j < s_.size() && std::isspace(static_cast<unsigned char>(s_[j]))) ++j;
+      return j < s_.size() && is_arithmetic(s_[j]);
+    };
+    if (c == '(' || peek_function(i)) return true;
+    if (c == '-' || c == '+') {
+      size_t j = i + 1;
+      while (j < s_.size() && std::isspace(static_cast<unsigned char>(s_[j]))) ++j;
+      if (j < s_.size() && (is_ident_start(s_[j]) || s_[j] == '(' || s_[j] == '-')) return true;
+    }
+    if (c == '-' || c == '+' || c == '.' || std::isdigit(static_cast<unsigned char>(c))) {
+      size_t j = i + 1;
+      while (j < s_.size() && (std::isalnum(static_cast<unsigned char>(s_[j])) || s_[j] == '.' ||
+                               ((s_[j] == '-' || s_[j] == '+') && (s_[j - 1] == 'e' || s_[j - 1] == 'E'))))
+        ++j;
+      return next_is_arithmetic(j);
+    }
+    if (!is_ident_start(c)) return false;
+    size_t j = i;
+    while (j < s_.size() && is_ident_char(s_[j])) ++j;
+    const std::string word = s_.substr(i, j - i);
+    if (word == "true" || word == "false") return false;
+    if (j < s_.size() && (s_[j] == '.' || s_[j] == '[')) return true;
+    return ordering || next_is_arithmetic(j);
+  }
+
+  // Expressions are trees of shared nodes freed recursively: their size is bounded.
+  static constexpr int kMaxExprNodes = 1000;
+  int expr_nodes_ = 0;
+  std::shared_ptr<Expr> new_expr(Expr::Kind kind, size_t at) {
+    if (++expr_nodes_ > kMaxExprNodes)
+      fail("expression too long: at most " + std::to_string(kMaxExprNodes) + " numbers, fields and operators in one atom",
+           at);
+    auto e = std::make_shared<Expr>();
+    e->kind = kind;
+    e->column = column(at);
+    return e;
+  }
+  ExprPtr field_expr(std::vector<std::string> path, size_t at) {
+    auto e = new_expr(Expr::Kind::Field, at);
+    e->path = std::move(path);
+    return e;
+  }
+  ExprPtr binary(Expr::Kind kind, ExprPtr a, ExprPtr b, size_t at) {
+    auto e = new_expr(kind, at);
+    e->args = {std::move(a), std::move(b)};
+    return e;
+  }
+
+  // `first`: a field already read as the first operand ({a.x - b.x < 1}).
+  ExprPtr parse_expr(ExprPtr first = nullptr) {
+    ExprPtr left = parse_term(std::move(first));
+    for (;;) {
+      skip_ws();
+      const size_t at = pos_;
+      if (peek() != '+' && peek() != '-') return left;
+      const Expr::Kind kind = peek() == '+' ? Expr::Kind::Add : Expr::Kind::Sub;
+      ++pos_;
+      left = binary(kind, std::move(left), parse_term(nullptr), at);
+    }
+  }
+  ExprPtr parse_term(ExprPtr first) {
+    ExprPtr left = first ? std::move(first) : parse_expr_unary();
+    for (;;) {
+      skip_ws();
+      const size_t at = pos_;
+      if (peek() != '*' && peek() != '/') return left;
+      const Expr::Kind kind = peek() == '*' ? Expr::Kind::Mul : Expr::Kind::Div;
+      ++pos_;
+      left = binary(kind, std::move(left), parse_expr_unary(), at);
+    }
+  }
+  ExprPtr parse_expr_unary() {
+    skip_ws();
+    const size_t at = pos_;
+    if (peek() != '-') return parse_expr_primary();
+    Nest nest(*this, at);
+    ++pos_;
+    ExprPtr operand = parse_expr_unary();
+    auto e = new_expr(Expr::Kind::Neg, at);
+    if (operand->kind == Expr::Kind::Number) {  // -3 is a number
+      e->kind = Expr::Kind::Number;
+      e->number = -operand->number;
+    } else {
+      e->args = {std::move(operand)};
+    }
+    return e;
+  }
+  ExprPtr parse_expr_primary() {
+    skip_ws();
+    const size_t at = pos_;
+    const char c = peek();
+    if (c == '(') {
+      Nest nest(*this, at);
+      ++pos_;
+      ExprPtr inner = parse_expr();
+      skip_ws();
+      if (peek() != ')') fail("expected ')' to close the '(' at column " + column_text(at), pos_);
+      ++pos_;
+      return inner;
+    }
+    if (std::isdigit(static_cast<unsigned char>(c)) || c == '.') {
+      auto e = new_expr(Expr::Kind::Number, at);
+      e->number = parse_number_token("the expression");
+      if (is_ident_char(peek()))  // {1x}: a key that starts with a digit
+        fail("expected a field name: names start with a letter or '_' (quote other keys: {\"1x\"})", at);
+      return e;
+    }
+    if (peek_function(at)) {
+      Nest nest(*this, at);
+      const Expr::Kind kind = c == 'a' ? Expr::Kind::Abs : s_[at + 1] == 'i' ? Expr::Kind::Min : Expr::Kind::Max;
+      pos_ += 4;  // "abs(", "min(", "max("
+      auto e = new_expr(kind, at);
+      e->args.push_back(parse_expr());
+      if (kind != Expr::Kind::Abs) {
+        expect(",", "between the two arguments of " + s_.substr(at, 3));
+        e->args.push_back(parse_expr());
+      }
+      skip_ws();
+      if (peek() == ',') fail(s_.substr(at, 3) + " takes " + (kind == Expr::Kind::Abs ? "one argument" : "two arguments"), pos_);
+      if (peek() != ')') fail("expected ')' to close " + s_.substr(at, 4), pos_);
+      ++pos_;
+      return e;
+    }
+    if (is_ident_start(c) || c == '"' || c == '@') {
+      Timed::Func func;
+      size_t length = 0;
+      if (peek_aggregate(func, length))
+        fail("an aggregate is compared with a number ({avg[0:2](x) > 3}); it cannot be part of an expression", at);
+      FieldTest t;
+      const size_t atom_at = parse_path(t);
+      if (t.is_timed()) fail("a timing atom is compared with a number ({x.@age <= 0.1}); it cannot be part of an expression", atom_at);
+      return field_expr(std::move(t.path), at);
+    }
+    if (c == '}' || c == ',' || at_end()) fail("expected a number, a field or '(' to complete the expression", at);
+    fail("unexpected '" + std::string(1, c) + "' in an expression: expected a number, a field, '(', abs, min or max", at);
+  }
+
+  // The comparison after an expression, and its right side.
+  FieldTest finish_expression_test(FieldTest t, ExprPtr lhs) {
+    skip_ws();
+    const size_t op_at = pos_;
+    using FOp = FieldTest::Op;
+    if (accept_symbol("==")) t.op = FOp::Eq;
+    else if (accept_symbol("!=")) t.op = FOp::Ne;
+    else if (accept_symbol("<=")) t.op = FOp::Le;
+    else if (accept_symbol(">=")) t.op = FOp::Ge;
+    else if (accept_symbol("<")) t.op = FOp::Lt;
+    else if (accept_symbol(">")) t.op = FOp::Gt;
+    else fail("an expression is a number: compare it (< <= > >= == !=) with another, e.g. {abs(a - b) < 0.1}", op_at);
+    t.path.clear();
+    return make_expression_test(std::move(t), std::move(lhs), parse_expr());
+  }
+
+  static FieldTest make_expression_test(FieldTest t, ExprPtr lhs, ExprPtr rhs) {
+    if (lhs->kind == Expr::Kind::Field && rhs->kind == Expr::Kind::Number) {  // {(x) < 3} is {x < 3}
+      t.path = lhs->path;
+      t.value.kind = Literal::Kind::Number;
+      t.value.number = rhs->number;
+      return t;
+    }
+    t.timed.kind = Timed::Kind::Expr;
+    t.lhs = std::move(lhs);
+    t.rhs = std::move(rhs);
     return t;
   }
 

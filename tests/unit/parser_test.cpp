@@ -484,7 +484,7 @@ TEST(ParserErrors, Atoms) {
   expect_error("{a > 1 b}", "expected ',' or '}' in the atom opened at column 1", 8);
   expect_error("{q} and {a, b c}", "after field 'b'", 15);  // 'c' where ':' or an operator belongs
   expect_error("{p: }", "expected a value (number, true, false or string)", 5);
-  expect_error("{speed > fast}", "'<', '<=', '>', '>=' compare numbers; this is not a number", 10);
+  expect_error("{speed > \"fast\"}", "'<', '<=', '>', '>=' compare numbers; this is not a number", 10);
   expect_error("{speed <= \"3\"}", "compare numbers", 11);
   expect_error("{speed >= true}", "compare numbers", 11);
   expect_error("{speed ~ 3}", "expected ':', a comparison (< <= > >= == !=), ',' or '}' after field 'speed'", 8);

@@ -1,5 +1,6 @@
 #include "engine/timed/timed_atoms.hpp"
 
+#include <charconv>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -46,6 +47,26 @@ TimedAtoms::TimedAtoms(AtomTable& atoms, const std::vector<std::string>& inputs,
   for (size_t id = 0; id < n; ++id) {
     const spec::FieldTest test = atoms.tests()[id];  // a copy: intern() below may grow the table
     if (!test.is_timed()) continue;
+    if (test.is_expr()) {  // whatever inputs its fields come from: they carry the input's name
+      auto leaf_of = [&](const std::vector<std::string>& path) {
+        spec::FieldTest field;
+        field.path = path;
+        field.op = FOp::Value;
+        const int hidden = atoms.intern(field);
+        for (size_t k = 0; k < leaves_.size(); ++k)
+          if (leaves_[k].id == hidden) return static_cast<int>(k);
+        leaves_.push_back({hidden, field.key()});
+        return static_cast<int>(leaves_.size() - 1);
+      };
+      ExprAtom e{static_cast<int>(id), test.op, CompiledExpr(*test.lhs, leaf_of), CompiledExpr(*test.rhs, leaf_of), {}};
+      std::vector<const spec::Expr*> fields;
+      spec::expr_fields(*test.lhs, fields);
+      spec::expr_fields(*test.rhs, fields);
+      for (const spec::Expr* f : fields) e.leaves.push_back(leaf_of(f->path));
+      exprs_.push_back(std::move(e));
+      field_values_ = true;
+      continue;
+    }
     // {steer.@age ..}, count(steer.@arrived), avg(steer.speed): the input
     // comes first; with one unnamed input there is none ({@age ..}, avg(speed)).
     const bool named = !inputs.empty() && !inputs[0].empty();
@@ -103,6 +124,49 @@ void TimedAtoms::arrive(uint32_t input, double latency, const uint8_t* values, c
     const double v = margins[s.value];
     if (std::isfinite(v)) windows_[k].add(now_, v);
   }
+  if (exprs_.empty()) return;
+  for (Leaf& l : leaves_) {
+    if (!values[l.id] || !margins) continue;
+    l.number = margins[l.id];
+    l.seen = true;
+  }
+  evaluate_exprs();
+}
+
+// Each field an expression reads keeps its last number (a message without
+// it, or with a value of another type, changes nothing: Reelay's rule for
+// every test); before its first number the expression has no value, and
+// every comparison with it is false (margin -inf, as a field never seen).
+void TimedAtoms::evaluate_exprs() {
+  // (Called after every message; the leaves are re-read from the committed
+  // values: in a synchronized run this message's input wrote its own.)
+  leaf_numbers_.resize(leaves_.size());
+  for (size_t k = 0; k < leaves_.size(); ++k) leaf_numbers_[k] = leaves_[k].number;
+  for (ExprAtom& e : exprs_) {
+    bool ready = true;
+    for (int k : e.leaves) ready = ready && leaves_[static_cast<size_t>(k)].seen;
+    if (!ready) {
+      e.holds = false;
+      e.margin = -kInf;
+      continue;
+    }
+    const double l = e.lhs.eval(leaf_numbers_.data(), stack_), r = e.rhs.eval(leaf_numbers_.data(), stack_);
+    e.holds = !std::isnan(l) && !std::isnan(r) && compare(e.op, l, r);
+    double m;
+    switch (e.op) {
+      case FOp::Lt:
+      case FOp::Le: m = r - l; break;
+      case FOp::Gt:
+      case FOp::Ge: m = l - r; break;
+      case FOp::Eq: m = -std::fabs(l - r); break;
+      default: m = std::fabs(l - r); break;  // !=
+    }
+    // An undefined value (NaN: 0/0, inf - inf) holds nothing; a margin that is
+    // NaN while both sides are numbers (inf <= inf) is +inf or -inf with the verdict.
+    if (std::isnan(l) || std::isnan(r)) m = -kInf;
+    else if (std::isnan(m)) m = e.holds ? kInf : -kInf;
+    e.margin = m;
+  }
 }
 
 double TimedAtoms::next_change() const {
@@ -149,8 +213,28 @@ bool TimedAtoms::holds(const Atom& a) const {
   return compare(a.op, measure(a), a.bound);
 }
 
+std::string TimedAtoms::describe(int atom_id) const {
+  std::string out;
+  for (const ExprAtom& e : exprs_) {
+    if (e.id != atom_id) continue;
+    for (int k : e.leaves) {
+      const Leaf& l = leaves_[static_cast<size_t>(k)];
+      out += (out.empty() ? "" : ", ") + l.key;
+      if (!l.seen) {
+        out += ": no number yet";
+        continue;
+      }
+      char buf[32];
+      const auto r = std::to_chars(buf, buf + sizeof buf, l.number);
+      out += " = " + std::string(buf, r.ptr);
+    }
+  }
+  return out;
+}
+
 void TimedAtoms::write(uint8_t* values) const {
   for (const Atom& a : atoms_) values[a.id] = holds(a) ? 1 : 0;
+  for (const ExprAtom& e : exprs_) values[e.id] = e.holds ? 1 : 0;
 }
 
 void TimedAtoms::write_margins(double* margins) const {
@@ -158,6 +242,7 @@ void TimedAtoms::write_margins(double* margins) const {
     if (a.kind == Kind::Arrived) margins[a.id] = holds(a) ? 1 : 0;  // a Boolean field's margin
     else margins[a.id] = margin(a.op, measure(a), a.bound);
   }
+  for (const ExprAtom& e : exprs_) margins[e.id] = e.margin;
 }
 
 }  // namespace rvc::engine::timed

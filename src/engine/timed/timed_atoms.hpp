@@ -13,11 +13,13 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
 #include "engine/atom_table.hpp"
 #include "engine/program.hpp"
+#include "engine/timed/expr_eval.hpp"
 #include "engine/timed/window_aggregate.hpp"
 
 namespace rvc::engine::timed {
@@ -31,8 +33,8 @@ class TimedAtoms {
   // give the sample. Throws std::invalid_argument for an atom on no input.
   TimedAtoms(AtomTable& atoms, const std::vector<std::string>& inputs, TimeModel model);
 
-  bool empty() const { return atoms_.empty(); }
-  // Some aggregate reads a field: the decoder must compute margins.
+  bool empty() const { return atoms_.empty() && exprs_.empty(); }
+  // Some aggregate or expression reads a field: the decoder must compute margins.
   bool needs_field_values() const { return field_values_; }
   // Some atom reads @latency: the runtime must know each message's arrival.
   bool needs_arrival() const { return latency_; }
@@ -55,6 +57,11 @@ class TimedAtoms {
   void write(uint8_t* values) const;
   void write_margins(double* margins) const;
 
+  // --explain: the numbers an expression atom computed with, "a = 1, b = 2.5"
+  // ("b: no number yet"); "" for any other atom.
+  std::string describe(int atom_id) const;
+  bool has_expressions() const { return !exprs_.empty(); }
+
  private:
   struct Atom {
     int id;               // in the atom table
@@ -75,6 +82,25 @@ class TimedAtoms {
     double latency = 0;   // its arrival - stamp (NaN: unknown)
     double arrived_at = -1;  // discrete: the step it last arrived in
   };
+  // An arithmetic comparison ({abs(a.x - b.x) < 0.1}, issue 29): its fields
+  // are hidden {field as a number} tests (FieldTest::Op::Value) whose
+  // committed value says the field was ever seen and whose margin holds its
+  // number. Its value changes only when a message arrives.
+  struct ExprAtom {
+    int id;
+    spec::FieldTest::Op op;
+    CompiledExpr lhs, rhs;
+    std::vector<int> leaves;  // indexes into leaves_ it reads
+    bool holds = false;
+    double margin = -std::numeric_limits<double>::infinity();
+  };
+  struct Leaf {
+    int id;  // the hidden Value test
+    std::string key;  // the field, as written
+    double number = 0;
+    bool seen = false;
+  };
+  void evaluate_exprs();
   double measure(const Atom& a) const;  // the atom's number now (age, latency, aggregate)
   bool holds(const Atom& a) const;
 
@@ -85,6 +111,9 @@ class TimedAtoms {
   std::vector<InputState> inputs_;
   std::vector<WindowAggregate> windows_;
   std::vector<Source> sources_;
+  std::vector<ExprAtom> exprs_;
+  std::vector<Leaf> leaves_;
+  std::vector<double> leaf_numbers_, stack_;
 };
 
 }  // namespace rvc::engine::timed
