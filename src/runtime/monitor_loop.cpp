@@ -222,7 +222,7 @@ void MonitorLoop::handle(const transport::Frame& f) {
     }
     if (options_.filter->projecting() && options_.filter->project(payload, projected_)) payload = projected_;
   }
-  feed_.feed_input(f.input, payload, f.seq ? f.seq : counters.received);
+  feed_.feed_keyed(f.input, f.key, payload, f.seq ? f.seq : counters.received);
 }
 
 void MonitorLoop::on_schedule(std::chrono::steady_clock::time_point now) {

@@ -22,6 +22,7 @@ void VerdictOutputs::put(const engine::Verdict& v) {
     }
     line_ += "]}\n";
   }
+  if (!mark_.empty() && !type_) line_.insert(line_.size() - 2, mark_);  // before "}\n"
   line_.pop_back();  // one message per verdict: no newline (file sinks add their own)
   put_payload(line_);
 }
