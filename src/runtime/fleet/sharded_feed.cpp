@@ -82,9 +82,12 @@ void ShardedFeed::follow_members() {
     if (!std::binary_search(now.begin(), now.end(), m)) gone += (gone.empty() ? "" : ",") + m;
   for (const auto& m : now)
     if (!std::binary_search(member_list_.begin(), member_list_.end(), m)) joined += (joined.empty() ? "" : ",") + m;
-  const bool first = member_list_.empty();
   member_list_ = std::move(now);
-  if (first) return;  // no shards yet
+  if (shards_.empty()) {  // nothing to hand over yet
+    std::fprintf(stderr, "rvc monitor: group %s: members %zu (%s)\n", options_.group.c_str(), member_list_.size(),
+                 joined.c_str());
+    return;
+  }
   size_t taken = 0, released = 0;
   uint64_t replayed_before = replayed_;
   std::string keys;
@@ -139,7 +142,12 @@ void ShardedFeed::take(Shard& s, std::chrono::steady_clock::time_point changed_a
   mark_handover_ = false;
   replayed_ += s.window.size();
   s.replay_received = s.window.size();
+  // What the replay counted is not this run's live count. A synchronizer may
+  // still hold the last replayed messages: they count as replayed too when
+  // a live message releases them into a set.
   s.replay = s.instance->stats();
+  s.replay_lost = s.instance->lost();
+  s.replay.accepted = s.window.size() - s.replay.rejected - s.replay_lost;
   s.window.clear();
   s.window.shrink_to_fit();
 }
@@ -149,7 +157,7 @@ void ShardedFeed::retire(Shard& s) {
   add_stats_to(live, s.replay, -1);
   add_stats_to(retired_, live);
   retired_violations_ += s.instance->violations();
-  retired_lost_ += s.instance->lost();
+  retired_lost_ += s.instance->lost() - s.replay_lost;
 }
 
 void ShardedFeed::release(Shard& s) {
@@ -159,6 +167,7 @@ void ShardedFeed::release(Shard& s) {
   retire(s);
   s.instance.reset();
   s.replay = PipelineStats{};
+  s.replay_lost = 0;
 }
 
 void ShardedFeed::on_verdict(const engine::Verdict& v) {
@@ -208,7 +217,7 @@ void ShardedFeed::add_dropped(io::JsonObject& out) const {
 uint64_t ShardedFeed::lost() const {
   uint64_t n = retired_lost_;
   for (const auto& [key, s] : shards_)
-    if (s->instance) n += s->instance->lost();
+    if (s->instance) n += s->instance->lost() - s->replay_lost;
   return n;
 }
 

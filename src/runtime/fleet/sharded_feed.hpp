@@ -86,6 +86,7 @@ class ShardedFeed final : public Feed {
     std::deque<Buffered> window;     // while not owned: the latest messages
     PipelineStats replay;            // of the instance's stats, what its replays counted
     uint64_t replay_received = 0;
+    uint64_t replay_lost = 0;        // of the instance's lost(), the replay's
   };
   Shard& shard(std::string_view key);
   void take(Shard& s, std::chrono::steady_clock::time_point changed_at);
