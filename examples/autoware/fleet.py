@@ -22,6 +22,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import pickle
 import random
 import struct
 import sys
@@ -52,8 +53,10 @@ def scenario_path(name: str) -> str:
     return name if os.path.exists(name) else os.path.join(HERE, "scenarios", name + ".yaml")
 
 
-def plan(n: int, scenarios: list[str], topics: dict, rate_scale: float, duration: float | None):
-    """Per vehicle: (id, scenario name, {topic name: [(stamp_ns, cdr bytes)]})."""
+def plan(n: int, scenarios: list[str], topics: dict, rate_scale: float, duration: float | None, loops: int = 1):
+    """Per vehicle: (id, scenario name, {topic name: [(stamp_ns, cdr bytes)]}); `loops` > 1 runs
+    the scenario again after itself (stamps moved on by its length plus 1 s; the CDR stamps stay
+    those of the first run, which no property reads)."""
     ts = vehicle.typestore()
     by_name = {t["name"]: t for t in topics["topics"]}
     loaded = {s: vehicle.Scenario(scenario_path(s)) for s in scenarios}
@@ -65,8 +68,10 @@ def plan(n: int, scenarios: list[str], topics: dict, rate_scale: float, duration
         out = {}
         for name, lst in msgs.items():
             type_name = by_name[name]["type"]
-            out[name] = [(ns, bytes(ts.serialize_cdr(vehicle.to_rosbags(ts, type_name, m), type_name)))
-                         for ns, m in lst if duration is None or ns - epoch_ns < duration * 1e9]
+            once = [(ns, bytes(ts.serialize_cdr(vehicle.to_rosbags(ts, type_name, m), type_name)))
+                    for ns, m in lst if duration is None or ns - epoch_ns < duration * 1e9]
+            span = int(((duration or sc.duration) + 1) * 1e9)
+            out[name] = [(ns + k * span, d) for k in range(loops) for ns, d in once]
         fleet.append((vehicle_id(i), sc.name, out))
     return fleet
 
@@ -120,10 +125,11 @@ def publish(fleet, topics: dict, sessions, speed: float, prefix: str, settle: fl
     start_ns = events[0][0] if events else 0
     t0 = time.monotonic()
     for ns, key, data in events:
-        due = t0 + (ns - start_ns) / 1e9 / speed
-        delay = due - time.monotonic()
-        if delay > 0.002:
-            time.sleep(delay)
+        if speed > 0:
+            due = t0 + (ns - start_ns) / 1e9 / speed
+            delay = due - time.monotonic()
+            if delay > 0.002:
+                time.sleep(delay)
         p = pubs[key]
         p[2] += 1
         p[0].put(data, attachment=attachment(p[2], p[1]))
@@ -141,7 +147,10 @@ def main(argv=None) -> int:
     r.add_argument("--vehicles", type=int, default=10)
     r.add_argument("--connect", action="append", required=True, help="a router endpoint (repeatable)")
     r.add_argument("--scenario", action="append", help="scenario names or files, assigned round robin")
-    r.add_argument("--speed", type=float, default=1.0, help="publish at this many times the stamps' pace")
+    r.add_argument("--speed", type=float, default=1.0,
+                   help="publish at this many times the stamps' pace (0: as fast as the network takes them)")
+    r.add_argument("--loop", type=int, default=1, help="run each scenario this many times, one after the other")
+    r.add_argument("--plan-cache", help="pickle of the generated messages: reused if it exists (benchmarks)")
     r.add_argument("--rate-scale", type=float, default=1.0)
     r.add_argument("--duration", type=float, help="only the first S seconds of each scenario")
     r.add_argument("--prefix", default="fleet")
@@ -156,7 +165,14 @@ def main(argv=None) -> int:
         print(" ".join(monitor_flags(topics, args.prefix)))
         return 0
     log = lambda s: print(s, file=sys.stderr, flush=True)  # noqa: E731
-    fleet = plan(args.vehicles, args.scenario or ["drive"], topics, args.rate_scale, args.duration)
+    if args.plan_cache and os.path.exists(args.plan_cache):
+        with open(args.plan_cache, "rb") as f:
+            fleet = pickle.load(f)
+    else:
+        fleet = plan(args.vehicles, args.scenario or ["drive"], topics, args.rate_scale, args.duration, args.loop)
+        if args.plan_cache:
+            with open(args.plan_cache, "wb") as f:
+                pickle.dump(fleet, f)
     if args.record:
         os.makedirs(args.record, exist_ok=True)
         for vid, sc, msgs in fleet:

@@ -21,7 +21,7 @@ struct GroupFlags {
   std::string name;        // --group
   std::string shard_by;    // --shard-by
   std::string member;      // --member (default: the Zenoh session id)
-  size_t replay_window = 1u << 20;
+  size_t replay_window = 16384;
   double handover_overlap = 3;
 
   void add_to(CLI::App& app);

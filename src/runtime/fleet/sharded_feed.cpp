@@ -68,6 +68,7 @@ void ShardedFeed::feed_keyed(uint32_t input, std::string_view key, std::string_v
   if (s.window.size() >= options_.replay_window) {
     s.window.pop_front();
     ++window_evicted_;
+    s.evicted = true;
   }
   s.window.push_back(Buffered{input, position, std::chrono::steady_clock::now(), std::string(payload)});
 }
@@ -89,7 +90,7 @@ void ShardedFeed::follow_members() {
     return;
   }
   size_t taken = 0, released = 0;
-  uint64_t replayed_before = replayed_;
+  const uint64_t replayed_before = replayed_, partial_before = partial_replays_;
   std::string keys;
   for (auto& [key, s] : shards_) {
     const bool mine = owner_of(key, member_list_) == members_.self();
@@ -120,6 +121,7 @@ void ShardedFeed::follow_members() {
         .add("taken", static_cast<uint64_t>(taken))
         .add("released", static_cast<uint64_t>(released))
         .add("replayed", replayed_ - replayed_before)
+        .add("partial_replays", partial_replays_ - partial_before)
         .add_raw("shards", "[" + keys + "]");
     io::JsonObject event;
     event.add_raw("handover", h.str());
@@ -129,6 +131,16 @@ void ShardedFeed::follow_members() {
 
 void ShardedFeed::take(Shard& s, std::chrono::steady_clock::time_point changed_at) {
   s.instance = factory_(s.key, [this](const engine::Verdict& v) { on_verdict(v); });
+  if (s.evicted) {
+    // Bounded properties are rebuilt from the last window; what depends on
+    // older messages (unbounded operators, discrete step numbers) may differ.
+    ++partial_replays_;
+    std::fprintf(stderr,
+                 "rvc monitor: group %s: warning: shard %s is replayed from its last %zu messages only "
+                 "(--replay-window): verdicts that depend on older messages may differ from one uninterrupted "
+                 "monitor's\n",
+                 options_.group.c_str(), s.key.c_str(), s.window.size());
+  }
   // The old owner may have died up to a lease before its token went, with
   // messages still queued: verdicts of what arrived since then are published again.
   const auto overlap_from = changed_at - std::chrono::duration_cast<std::chrono::steady_clock::duration>(
@@ -150,6 +162,7 @@ void ShardedFeed::take(Shard& s, std::chrono::steady_clock::time_point changed_a
   s.replay.accepted = s.window.size() - s.replay.rejected - s.replay_lost;
   s.window.clear();
   s.window.shrink_to_fit();
+  s.evicted = false;
 }
 
 void ShardedFeed::retire(Shard& s) {
@@ -168,6 +181,7 @@ void ShardedFeed::release(Shard& s) {
   s.instance.reset();
   s.replay = PipelineStats{};
   s.replay_lost = 0;
+  s.evicted = true;  // the window restarts here: taken back, it replays from now on only
 }
 
 void ShardedFeed::on_verdict(const engine::Verdict& v) {
@@ -259,7 +273,8 @@ void ShardedFeed::add_stats(io::JsonObject& out) const {
       .add("handovers", handovers_)
       .add("replayed", replayed_)
       .add("handover_verdicts", replayed_verdicts_)
-      .add("window_evicted", window_evicted_);
+      .add("window_evicted", window_evicted_)
+      .add("partial_replays", partial_replays_);
   out.add_raw("group", g.str());
 }
 

@@ -38,7 +38,7 @@ namespace rvc::runtime::fleet {
 
 struct ShardedOptions {
   std::string group;                 // the group's name (messages, counters)
-  size_t replay_window = 1u << 20;   // messages kept per shard this replica does not own
+  size_t replay_window = 16384;      // messages kept per shard this replica does not own
   double handover_overlap = 3;       // seconds: replayed messages this recent get their verdicts published
   // Called on the engine thread at each handover (the results database
   // records it): the JSON object describing it.
@@ -84,6 +84,7 @@ class ShardedFeed final : public Feed {
     std::string key;
     std::unique_ptr<Feed> instance;  // null: another replica owns it
     std::deque<Buffered> window;     // while not owned: the latest messages
+    bool evicted = false;            // the window lost its oldest messages: the replay starts mid-history
     PipelineStats replay;            // of the instance's stats, what its replays counted
     uint64_t replay_received = 0;
     uint64_t replay_lost = 0;        // of the instance's lost(), the replay's
@@ -103,7 +104,7 @@ class ShardedFeed final : public Feed {
   std::vector<std::string> member_list_;
   uint64_t generation_ = UINT64_MAX;
   uint64_t received_ = 0, not_owned_ = 0, no_shard_ = 0, window_evicted_ = 0;
-  uint64_t handovers_ = 0, replayed_ = 0, replayed_verdicts_ = 0, withheld_verdicts_ = 0;
+  uint64_t handovers_ = 0, replayed_ = 0, partial_replays_ = 0, replayed_verdicts_ = 0, withheld_verdicts_ = 0;
   PipelineStats retired_;       // of instances released to another replica (live part)
   uint64_t retired_violations_ = 0, retired_lost_ = 0;
   bool withhold_ = false;       // replaying the part of a window the old owner checked
