@@ -123,7 +123,9 @@ struct MonitorCommand {
   // The last array, with the final counters; a failing output fails the run.
   void finish_health(runtime::Outcome& outcome, const runtime::MonitorLoop& loop) {
     liveliness_token.reset();
-    group.leave();  // the others take this replica's shards at once  // an orderly end: the token goes at once (a killed monitor's when its lease expires)
+    // Killed or stopped by a signal, the others take this replica's shards
+    // over; at the end of the stream they keep them (it checked everything).
+    group.leave(loop.end_reason() == runtime::EndReason::EndOfStream);  // an orderly end: the token goes at once (a killed monitor's when its lease expires)
     if (!diagnostics) return;
     try {
       diagnostics->finish(loop);

@@ -2,6 +2,7 @@
 
 #include <cstdio>
 #include <stdexcept>
+#include <thread>
 
 #include "cli/option_ranges.hpp"
 #ifdef RVC_HAVE_ZENOH
@@ -73,6 +74,13 @@ void GroupFlags::join(const transport::TransportOptions& transports) {
         if (key.size() > prefix.size() && key.substr(0, prefix.size()) == prefix)
           members->update(key.substr(prefix.size()), alive);
       });
+  byes_ = std::make_shared<transport::ZenohSubscriber>(
+      session, prefix + "*/bye",
+      [members, prefix](const transport::ZenohSample& sample) {
+        std::string_view key = sample.key.substr(prefix.size());
+        members->retire(key.substr(0, key.find('/')));
+      },
+      false);
   token_ = std::make_shared<transport::ZenohLivelinessToken>(session, prefix + member);
   session_ = session;
   std::fprintf(stderr, "rvc monitor: group %s: member %s (token %s%s), shards by '%s'\n", name.c_str(),
@@ -84,7 +92,23 @@ void GroupFlags::join(const transport::TransportOptions&) {
 }
 #endif
 
-void GroupFlags::leave() {
+void GroupFlags::leave(bool at_end_of_stream) {
+#ifdef RVC_HAVE_ZENOH
+  if (at_end_of_stream && session_) {
+    try {
+      transport::ZenohPublisher bye(std::static_pointer_cast<transport::ZenohSession>(session_),
+                                    "@rvc/group/" + name + "/" + member + "/bye");
+      bye.put("{\"reason\":\"end of stream\"}");
+      // Before the token goes: the others must read the bye first.
+      std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "rvc: group %s: could not say bye: %s\n", name.c_str(), e.what());
+    }
+  }
+#else
+  (void)at_end_of_stream;
+#endif
+  byes_.reset();
   token_.reset();
   watch_.reset();
   session_.reset();

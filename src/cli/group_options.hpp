@@ -36,11 +36,14 @@ struct GroupFlags {
   // The properties of one shard's instance: "<shard>/<name>".
   static std::vector<engine::PropertySpec> shard_properties(const std::vector<engine::PropertySpec>& properties,
                                                             const std::string& shard);
-  void leave();  // an orderly end: the token goes at once
+  // An orderly end: the token goes at once. `at_end_of_stream`: every
+  // publisher ended and this replica checked all it owns: it says "bye"
+  // first, so the others keep its shards as they are instead of taking them over.
+  void leave(bool at_end_of_stream);
 
  private:
   std::unique_ptr<runtime::fleet::GroupMembers> members_;
-  std::shared_ptr<void> session_, token_, watch_;
+  std::shared_ptr<void> session_, token_, watch_, byes_;
 };
 
 }  // namespace rvc::cli

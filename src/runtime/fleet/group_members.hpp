@@ -29,10 +29,24 @@ class GroupMembers {
     std::lock_guard<std::mutex> lock(mutex_);
     const std::string m(member);
     if (m == self_) return;
+    if (!alive && retired_.count(m)) return;  // ended at end of stream: still its shards' owner
     const bool changed = alive ? members_.insert(m).second : members_.erase(m) > 0;
     if (!changed) return;
     changed_at_ = std::chrono::steady_clock::now();
     generation_.fetch_add(1, std::memory_order_release);
+  }
+
+  // A member that ended at the end of the stream (its "bye", sent before its
+  // token goes): it checked everything of its shards, so they keep it as their
+  // owner and nobody takes them over when its token goes.
+  void retire(std::string_view member) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const std::string m(member);
+    if (m == self_ || !retired_.insert(m).second) return;
+    if (members_.insert(m).second) {
+      changed_at_ = std::chrono::steady_clock::now();
+      generation_.fetch_add(1, std::memory_order_release);
+    }
   }
 
   uint64_t generation() const { return generation_.load(std::memory_order_acquire); }
@@ -47,7 +61,7 @@ class GroupMembers {
  private:
   const std::string self_;
   mutable std::mutex mutex_;
-  std::set<std::string> members_;
+  std::set<std::string> members_, retired_;
   std::chrono::steady_clock::time_point changed_at_ = std::chrono::steady_clock::now();
   std::atomic<uint64_t> generation_{0};
 };

@@ -226,3 +226,43 @@ def test_group_survives_a_killed_replica_with_verdicts_equal_offline(rvc, procs,
             differ.append((vid, ids[vid], sorted(set(offline.items()) ^ set(live.get(vid, {}).items()))[:4]))
     assert not differ, differ
     print(f"{vehicles} vehicles, {total} messages, verdicts equal offline; {twice} published twice at the handover")
+
+
+def test_group_counts_add_up_across_replicas_and_an_orderly_end_hands_nothing_over(rvc, procs, tmp_path):
+    """Two replicas, no kill: the owners' checked messages sum to what the publishers sent, each
+    replica's "not owned" is the rest, and a replica ending at the end of the stream says bye, so
+    the other one takes nothing over (no handover, no message checked twice)."""
+    vehicles = 12
+    topics = vehicle.load_topics()
+    ports = routers(rvc, procs, 2)
+    flags = []
+    for t in topics["topics"]:
+        flags += ["--input", f"{t['name']}=zenoh:fleet/*/{t['topic'].lstrip('/')}", "--type", t["type"]]
+    reps = []
+    for i in range(2):
+        reps.append(procs([rvc, "monitor", *flags, "--sync", "merge",
+                           "--properties", os.path.join(EXAMPLE, "properties.yaml"),
+                           "--group", "pair", "--shard-by", "fleet/*", "--member", f"p{i}",
+                           "--exit-on-eos", "--publishers", str(vehicles), "--idle-timeout", "120",
+                           "--mode", "client", "--connect", ep(ports[i]), "--no-multicast-scouting",
+                           "-o", "file:/dev/null"]))
+    for r in reps:
+        r.wait_for("members 2", timeout=30)
+    record = tmp_path / "fleet"
+    sim = procs([sys.executable, os.path.join(EXAMPLE, "fleet.py"), "run", "--vehicles", str(vehicles),
+                 "--connect", ep(ports[0]), "--connect", ep(ports[1]), "--scenario", "drive",
+                 "--duration", "4", "--speed", "0", "--record", str(record)])
+    sim.p.wait(timeout=180)
+    assert sim.p.returncode == 0, sim.stderr()
+    total = sum(json.loads((record / "sent.json").read_text()).values())
+    checked = 0
+    for r in reps:
+        r.p.wait(timeout=120)
+        c = counters(r.stderr())
+        assert r.p.returncode == 0, r.stderr()[-2000:]
+        assert c["received"] == total and c["gaps"] == 0, c
+        assert c["dropped"] == {"not owned": total - c["checked"]}, c
+        assert c["group"]["handovers"] == 0 and c["group"]["replayed"] == 0, c
+        assert c["group"]["owned"] > 0, c
+        checked += c["checked"]
+    assert checked == total
