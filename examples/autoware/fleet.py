@@ -135,7 +135,17 @@ def publish(fleet, topics: dict, sessions, speed: float, prefix: str, settle: fl
         p[0].put(data, attachment=attachment(p[2], p[1]))
     for key, p in pubs.items():
         p[0].put(b"", attachment=attachment(p[2], p[1], eos=True))
+    # Closing a session may drop samples still queued: first a flush barrier per session, rvc's
+    # query on rvc/flush/<key> (docs/zenoh.md, "Flush"), which travels behind the data and is
+    # answered by each rvc subscriber once it has taken every earlier sample.
+    answered = 0
+    for session in sessions:
+        for reply in session.get(f"rvc/flush/{prefix}/**", timeout=60.0,
+                                 congestion_control=zenoh.CongestionControl.BLOCK,
+                                 consolidation=zenoh.ConsolidationMode.NONE):
+            answered += reply.ok is not None
     elapsed = time.monotonic() - t0
+    log(f"fleet: {answered} flush answers")
     log(f"fleet: sent {len(events)} messages in {elapsed:.2f} s ({len(events) / max(elapsed, 1e-9):.0f}/s)")
     return {key: p[2] for key, p in pubs.items()}
 
