@@ -110,6 +110,7 @@ class ShardedFeed final : public Feed {
   bool withhold_ = false;       // replaying the part of a window the old owner checked
   bool mark_handover_ = false;  // replaying the overlap: verdicts marked "handover"
   bool ended_ = false;
+  std::chrono::steady_clock::time_point last_idle_{};
   mutable PipelineStats stats_;
 };
 
