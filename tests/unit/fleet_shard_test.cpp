@@ -131,5 +131,42 @@ TEST(ShardedFeed, TakeoverReplaysTheWindowAndGoesOnAsAnUninterruptedMonitor) {
   EXPECT_EQ(feed.handovers(), 1u);
 }
 
+
+// A member joins (scale-up): the shards it now owns are handed on, their
+// live counts stay counted once, and messages of those shards are dropped
+// as "not owned" from then on.
+TEST(ShardedFeed, AJoiningMemberTakesItsShardsAndTheCountsStayWhole) {
+  GroupMembers members("self");
+  std::vector<std::string> lines;
+  std::vector<std::unique_ptr<transport::Sink>> sinks;
+  sinks.push_back(std::make_unique<LinesSink>(lines));
+  VerdictOutputs outputs(std::move(sinks), true);
+  ShardedFeed feed(
+      ShardPattern("fleet/*"), members,
+      [&](const std::string& shard, engine::VerdictCallback cb) {
+        return std::make_unique<Pipeline>(std::vector<engine::PropertySpec>{{shard + "/p", "{ok}"}}, discrete(),
+                                          std::move(cb));
+      },
+      outputs, ShardedOptions{});
+  const int n = 40;
+  for (int i = 0; i < n; ++i) feed.feed_keyed(0, "fleet/v" + std::to_string(i) + "/x", R"({"ok":true})", 1);
+  EXPECT_EQ(feed.owned(), size_t(n));
+  members.update("new", true);
+  int theirs = 0;
+  for (int i = 0; i < n; ++i) {
+    const std::string shard = "fleet/v" + std::to_string(i);
+    theirs += owner_of(shard, {"new", "self"}) == "new";
+    feed.feed_keyed(0, shard + "/x", R"({"ok":true})", 2);
+  }
+  ASSERT_GT(theirs, 0);
+  EXPECT_EQ(feed.owned(), size_t(n - theirs));
+  EXPECT_EQ(feed.received(), size_t(2 * n));
+  EXPECT_EQ(feed.stats().accepted, size_t(2 * n - theirs));  // the handed-on instances' checks still count
+  io::JsonObject c;
+  feed.add_dropped(c);
+  EXPECT_EQ(c.str(), "{\"not owned\":" + std::to_string(theirs) + "}");
+  EXPECT_EQ(lines.size(), size_t(n));  // one first verdict per shard, none again
+}
+
 }  // namespace
 }  // namespace rvc::runtime::fleet
