@@ -168,5 +168,38 @@ TEST(ShardedFeed, AJoiningMemberTakesItsShardsAndTheCountsStayWhole) {
   EXPECT_EQ(lines.size(), size_t(n));  // one first verdict per shard, none again
 }
 
+
+// A replica that started after the vehicle (its first sequence number is
+// past 1) does not have the shard's history: a takeover says so.
+TEST(ShardedFeed, ATakeoverOfAShardSeenFromMidStreamIsReportedPartial) {
+  GroupMembers members("self");
+  members.update("other", true);
+  std::vector<std::string> lines;
+  std::vector<std::unique_ptr<transport::Sink>> sinks;
+  sinks.push_back(std::make_unique<LinesSink>(lines));
+  VerdictOutputs outputs(std::move(sinks), true);
+  ShardedFeed feed(
+      ShardPattern("fleet/*"), members,
+      [&](const std::string& shard, engine::VerdictCallback cb) {
+        return std::make_unique<Pipeline>(std::vector<engine::PropertySpec>{{shard + "/p", "{ok}"}}, discrete(),
+                                          std::move(cb));
+      },
+      outputs, ShardedOptions{});
+  std::string late, early;
+  for (int i = 0; late.empty() || early.empty(); ++i) {
+    const std::string shard = "fleet/v" + std::to_string(i);
+    if (owner_of(shard, {"other", "self"}) != "other") continue;
+    (late.empty() ? late : early) = shard;
+  }
+  feed.feed_keyed(0, late + "/x", R"({"ok":true})", 7);   // its publisher had sent 6 before
+  feed.feed_keyed(0, early + "/x", R"({"ok":true})", 1);
+  members.update("other", false);
+  feed.follow_members();
+  io::JsonObject g;
+  feed.add_stats(g);
+  EXPECT_NE(g.str().find("\"partial_replays\":1}"), std::string::npos) << g.str();
+  EXPECT_EQ(feed.owned(), 2u);
+}
+
 }  // namespace
 }  // namespace rvc::runtime::fleet

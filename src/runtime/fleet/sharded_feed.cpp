@@ -59,6 +59,13 @@ void ShardedFeed::feed_keyed(uint32_t input, std::string_view key, std::string_v
     return;
   }
   Shard& s = shard(*shard_key);
+  if (input < 64 && !(s.inputs_seen & (uint64_t{1} << input))) {
+    // The first message of this input's publisher here: a sequence number
+    // past 1 means this replica started after the vehicle did, so what it
+    // keeps of the shard is not its whole history.
+    s.inputs_seen |= uint64_t{1} << input;
+    if (position > 1) s.evicted = true;
+  }
   if (s.instance) {
     s.instance->feed_input(input, payload, position);
     return;

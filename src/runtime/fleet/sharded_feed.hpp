@@ -84,7 +84,8 @@ class ShardedFeed final : public Feed {
     std::string key;
     std::unique_ptr<Feed> instance;  // null: another replica owns it
     std::deque<Buffered> window;     // while not owned: the latest messages
-    bool evicted = false;            // the window lost its oldest messages: the replay starts mid-history
+    bool evicted = false;            // the window lacks the shard's oldest messages: the replay starts mid-history
+    uint64_t inputs_seen = 0;        // inputs (bit i, the first 64) whose first message this replica has had
     PipelineStats replay;            // of the instance's stats, what its replays counted
     uint64_t replay_received = 0;
     uint64_t replay_lost = 0;        // of the instance's lost(), the replay's

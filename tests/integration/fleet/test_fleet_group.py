@@ -208,6 +208,8 @@ def test_group_survives_a_killed_replica_with_verdicts_equal_offline(rvc, procs,
         assert c["received"] == c["checked"] + c["rejected"] + dropped, c
         assert c["rejected"] == 0, c
         taken += c["group"]["handovers"]
+        # Each replica had every taken shard's whole history: an exact replay, also of `historically`.
+        assert c["group"]["partial_replays"] == 0 and c["group"]["replayed"] > 0, c
         assert c["group"]["members"] == 2, c
         db = sqlite3.connect(tmp_path / f"{name}.db")
         rows = [r[0] for r in db.execute("SELECT counters FROM counters") if '"handover"' in r[0]]
