@@ -134,15 +134,15 @@ def simulator(ports, vehicles, duration, speed, loops=1, cache=None):
     return Proc(args)
 
 
-def scale(rvc):
+def scale(rvc, sizes=((100, 10), (1000, 1.2)), replicas=(1, 2, 4), extra=()):
     results = []
-    for vehicles, duration in ((100, 10), (1000, 1.2)):
+    for vehicles, duration in sizes:
         cache = f"/tmp/rvc_fleet_bench_plan_{vehicles}_{duration}.pickle"
-        for n in (1, 2, 4):
+        for n in replicas:
             procs = []
             try:
                 ports = mesh(rvc, procs)
-                reps = [replica(rvc, f"r{i}", ports[i % 3], vehicles) for i in range(n)]
+                reps = [replica(rvc, f"r{i}", ports[i % 3], vehicles, extra) for i in range(n)]
                 procs += reps
                 for r in reps:
                     r.wait_for(f"members {n}")
@@ -151,7 +151,7 @@ def scale(rvc):
                 sim.reap(600)
                 for r in reps:
                     r.reap(300)
-                row = {"vehicles": vehicles, "replicas": n, "replica": []}
+                row = {"vehicles": vehicles, "replicas": n, "flags": list(extra), "replica": []}
                 firsts, dones, total = [], [], 0
                 for r in reps:
                     c = r.counters()
@@ -230,12 +230,19 @@ def failover(rvc, kills):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("what", choices=["scale", "failover"])
+    ap.add_argument("what", choices=["scale", "failover", "window"],
+                    help="window: 100 vehicles x 4 replicas with --replay-window 0 and the default, "
+                         "the cost of keeping the window on the drop path")
     ap.add_argument("--rvc", default=os.path.join(ROOT, "build", "release", "rvc"))
     ap.add_argument("--out", default="/tmp/rvc_fleet_bench.json")
     ap.add_argument("--kills", type=int, default=20)
     args = ap.parse_args()
-    res = scale(args.rvc) if args.what == "scale" else failover(args.rvc, args.kills)
+    if args.what == "scale":
+        res = scale(args.rvc)
+    elif args.what == "window":
+        res = scale(args.rvc, ((100, 10),), (4,), ("--replay-window", "0")) + scale(args.rvc, ((100, 10),), (4,))
+    else:
+        res = failover(args.rvc, args.kills)
     with open(args.out, "w") as f:
         json.dump({"what": args.what, "load": os.getloadavg(), "results": res}, f, indent=1)
     print(f"written {args.out}")
