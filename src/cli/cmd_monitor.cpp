@@ -407,6 +407,7 @@ struct MonitorCommand {
           verdicts);
     }
     runtime::LoopOptions lopts = loop_options(files != 0);
+    lopts.join_mid_stream = group.given();
     clock.open_ros_clock(lopts, transports);
     lopts.input_names = names;
     lopts.input = SyncFlags::joined_names(named);
@@ -580,6 +581,7 @@ struct MonitorCommand {
     start_results({input}, properties);
 
     runtime::LoopOptions lopts = loop_options(transport::scheme_of(input) == "file");
+    lopts.join_mid_stream = group.given();
     lopts.per_publisher = transport::scheme_of(input) == "rmw_zenoh";  // GIDs: loss per publisher
     clock.open_ros_clock(lopts, transports);
     record_counters(lopts);

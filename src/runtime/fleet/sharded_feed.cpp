@@ -37,8 +37,6 @@ ShardedFeed::Shard& ShardedFeed::shard(std::string_view key) {
   s->key = std::string(key);
   Shard& ref = *s;
   shards_.emplace(s->key, std::move(s));
-  // A shard seen for the first time is no handover: its owner starts it.
-  if (owner_of(ref.key, member_list_) == members_.self()) ref.instance = factory_(ref.key, [this](const engine::Verdict& v) { on_verdict(v); });
   return ref;
 }
 
@@ -65,6 +63,12 @@ void ShardedFeed::feed_keyed(uint32_t input, std::string_view key, std::string_v
     // keeps of the shard is not its whole history.
     s.inputs_seen |= uint64_t{1} << input;
     if (position > 1) s.evicted = true;
+  }
+  if (!s.started) {
+    // A shard seen for the first time is no handover: its owner starts it
+    // (with nothing to replay; partial if the vehicle started before this replica).
+    s.started = true;
+    if (owner_of(s.key, member_list_) == members_.self()) take(s, std::chrono::steady_clock::now());
   }
   if (s.instance) {
     s.instance->feed_input(input, payload, position);

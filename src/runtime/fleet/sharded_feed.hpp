@@ -85,6 +85,7 @@ class ShardedFeed final : public Feed {
     std::unique_ptr<Feed> instance;  // null: another replica owns it
     std::deque<Buffered> window;     // while not owned: the latest messages
     bool evicted = false;            // the window lacks the shard's oldest messages: the replay starts mid-history
+    bool started = false;            // its first message came: owned or not, it is known
     uint64_t inputs_seen = 0;        // inputs (bit i, the first 64) whose first message this replica has had
     PipelineStats replay;            // of the instance's stats, what its replays counted
     uint64_t replay_received = 0;

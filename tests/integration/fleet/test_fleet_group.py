@@ -268,3 +268,79 @@ def test_group_counts_add_up_across_replicas_and_an_orderly_end_hands_nothing_ov
         assert c["group"]["owned"] > 0, c
         checked += c["checked"]
     assert checked == total
+
+
+def test_a_replica_joining_mid_run_takes_its_shards_and_reports_them_partial(rvc, procs, tmp_path):
+    """Scale-up, 2 -> 3 replicas while 12 vehicles publish: the newcomer takes the shards rendezvous
+    gives it (the others hand them on), reports them as partial (it never saw their start), counts
+    the numbers its publishers had sent before it joined as before_join, not as loss; the vehicles
+    that stayed with the first two replicas still have exactly the offline verdicts."""
+    vehicles = 12
+    topics = vehicle.load_topics()
+    ports = routers(rvc, procs, 2)
+    flags = []
+    for t in topics["topics"]:
+        flags += ["--input", f"{t['name']}=zenoh:fleet/*/{t['topic'].lstrip('/')}", "--type", t["type"]]
+
+    def replica(name, port):
+        return procs([rvc, "monitor", *flags, "--sync", "merge",
+                      "--properties", os.path.join(EXAMPLE, "properties.yaml"),
+                      "--group", "grow", "--shard-by", "fleet/*", "--member", name,
+                      "--exit-on-eos", "--publishers", str(vehicles), "--idle-timeout", "120",
+                      "--mode", "client", "--connect", ep(port), "--no-multicast-scouting",
+                      "-o", f"file:{tmp_path / name}.jsonl"])
+
+    reps = {"g0": replica("g0", ports[0]), "g1": replica("g1", ports[1])}
+    for r in reps.values():
+        r.wait_for("members 2", timeout=30)
+    record = tmp_path / "fleet"
+    sim = procs([sys.executable, os.path.join(EXAMPLE, "fleet.py"), "run", "--vehicles", str(vehicles),
+                 "--connect", ep(ports[0]), "--connect", ep(ports[1]), "--scenario", "drive",
+                 "--scenario", "fault-hazard-late", "--duration", "8", "--speed", "2", "--record", str(record)])
+    sim.wait_for(f"fleet: {vehicles} vehicles", timeout=120)
+    time.sleep(1.5)
+    reps["g2"] = replica("g2", ports[0])
+    reps["g2"].wait_for("members 3", timeout=30)
+    sim.p.wait(timeout=120)
+    assert sim.p.returncode == 0, sim.stderr()
+    total = sum(json.loads((record / "sent.json").read_text()).values())
+    c = {}
+    for name, r in reps.items():
+        r.p.wait(timeout=120)
+        assert r.p.returncode in (0, 1), r.stderr()[-2000:]
+        c[name] = counters(r.stderr())
+        assert c[name]["gaps"] == 0 and c[name]["duplicates"] == 0, c[name]
+        assert c[name]["received"] + c[name]["before_join"] == total, c[name]
+        dropped = sum(c[name]["dropped"].values())
+        assert c[name]["received"] == c[name]["checked"] + c[name]["rejected"] + dropped, c[name]
+    assert c["g0"]["before_join"] == 0 and c["g1"]["before_join"] == 0
+    assert c["g2"]["before_join"] > 0
+    g2 = c["g2"]["group"]
+    assert g2["owned"] > 0 and g2["partial_replays"] == g2["owned"], g2
+    handed = sum("handed" in line and "handed 0 on" not in line
+                 for n in ("g0", "g1") for line in reps[n].stderr().splitlines())
+    assert handed >= 1, "the first replicas handed shards on"
+
+    live, _ = group_verdicts([tmp_path / f"{n}.jsonl" for n in reps])
+    moved = {vid for vid in json.loads((record / "vehicles.json").read_text())
+             if fleet_owner(f"fleet/{vid}", ["g0", "g1", "g2"]) == "g2"}
+    stayed = sorted(set(json.loads((record / "vehicles.json").read_text())) - moved)
+    assert moved and stayed
+    for vid in stayed:
+        assert live.get(vid) == offline_verdicts(rvc, record / vid / "bag", topics), vid
+
+
+def fleet_owner(shard, members):
+    """rvc's rendezvous owner (runtime/fleet/shard_map.cpp), written again from its description:
+    FNV-1a 64 over member, NUL, shard; splitmix64's finalizer; the highest hash wins."""
+    def h(a, b):
+        x = 14695981039346656037
+        for ch in a.encode() + b"\0" + b.encode():
+            x = ((x ^ ch) * 1099511628211) & 0xFFFFFFFFFFFFFFFF
+        x ^= x >> 30
+        x = (x * 0xbf58476d1ce4e5b9) & 0xFFFFFFFFFFFFFFFF
+        x ^= x >> 27
+        x = (x * 0x94d049bb133111eb) & 0xFFFFFFFFFFFFFFFF
+        x ^= x >> 31
+        return x
+    return max(sorted(members), key=lambda m: h(m, shard))
