@@ -13,6 +13,7 @@
 #include "cli/option_ranges.hpp"
 #include "cli/commands.hpp"
 #include "cli/diagnostics_flags.hpp"
+#include "cli/group_options.hpp"
 #include "cli/store_options.hpp"
 #include "cli/transport_flags.hpp"
 #include "cli/signals.hpp"
@@ -69,6 +70,36 @@ struct MonitorCommand {
   DiagnosticsFlags health;                 // --diagnostics, --name, --level, liveliness
   std::unique_ptr<runtime::DiagnosticsOutput> diagnostics;
   std::shared_ptr<void> liveliness_token;  // rvc/monitors/<name> while the monitor runs
+  GroupFlags group;                        // --group, --shard-by: one replica of a monitor group
+  std::unique_ptr<runtime::fleet::ShardedFeed> sharded;
+
+  // --group: refuses what a replica cannot do, then joins (token, member set).
+  int join_group(const std::vector<std::string>& uris) {
+    std::string why = group.refuse(uris);
+    if (why.empty() && check.calls) why = "--group checks each shard's messages; --calls is for one service";
+    if (why.empty() && !forward_property.empty()) why = "--group: --forward republishes one input, not shards";
+    if (why.empty() && clock.clock != "auto" && clock.clock != "off")
+      why = "--group: the instances move with their own messages; drop --clock";
+    if (!why.empty()) {
+      std::fprintf(stderr, "rvc: %s\n", why.c_str());
+      return kUsage;
+    }
+    try {
+      group.join(transports);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "rvc: %s\n", e.what());
+      return kRuntime;
+    }
+    return 0;
+  }
+  // The feed of a replica: one instance per owned shard, made by `factory`.
+  runtime::Feed& make_sharded(runtime::fleet::InstanceFactory factory, runtime::VerdictOutputs& verdicts) {
+    auto opts = group.sharded_options();
+    if (results) opts.on_handover = [this](const std::string& json) { results->counters(json); };
+    sharded = std::make_unique<runtime::fleet::ShardedFeed>(runtime::fleet::ShardPattern(group.shard_by),
+                                                             group.members(), std::move(factory), verdicts, opts);
+    return *sharded;
+  }
 
   // The /diagnostics output (fed by the verdicts and the loop's ticks) and
   // the Zenoh liveliness token, once the outputs are open.
@@ -91,7 +122,10 @@ struct MonitorCommand {
   }
   // The last array, with the final counters; a failing output fails the run.
   void finish_health(runtime::Outcome& outcome, const runtime::MonitorLoop& loop) {
-    liveliness_token.reset();  // an orderly end: the token goes at once (a killed monitor's when its lease expires)
+    liveliness_token.reset();
+    // Killed or stopped by a signal, the others take this replica's shards
+    // over; at the end of the stream they keep them (it checked everything).
+    group.leave(loop.end_reason() == runtime::EndReason::EndOfStream);  // an orderly end: the token goes at once (a killed monitor's when its lease expires)
     if (!diagnostics) return;
     try {
       diagnostics->finish(loop);
@@ -342,6 +376,8 @@ struct MonitorCommand {
       return kUsage;
     }
     if (refuse_own_inputs(uris)) return kUsage;
+    if (group.given())
+      if (int status = join_group(uris)) return status;
     if (!forward_property.empty()) {
       std::fprintf(stderr, "rvc: --forward republishes the messages of one input; several inputs are checked as sets\n");
       return kUsage;
@@ -368,7 +404,18 @@ struct MonitorCommand {
     runtime::SyncedPipeline pipeline(properties, popts, named, sync.options(named),
                                      [&](const engine::Verdict& v) { verdicts.put(v); }, on_set);
     start_results(uris, properties);
+    runtime::Feed* feed = &pipeline;
+    if (group.given()) {
+      const runtime::SyncOptions sync_options = sync.options(named);
+      feed = &make_sharded(
+          [&properties, popts, named, sync_options](const std::string& shard, engine::VerdictCallback on_verdict) {
+            return std::make_unique<runtime::SyncedPipeline>(GroupFlags::shard_properties(properties, shard), popts,
+                                                             named, sync_options, std::move(on_verdict));
+          },
+          verdicts);
+    }
     runtime::LoopOptions lopts = loop_options(files != 0);
+    lopts.join_mid_stream = group.given();
     clock.open_ros_clock(lopts, transports);
     lopts.input_names = names;
     lopts.input = SyncFlags::joined_names(named);
@@ -377,7 +424,7 @@ struct MonitorCommand {
     record_counters(lopts);
     attach_health(lopts);
     set_filter(lopts, uris);
-    runtime::MonitorLoop loop(pipeline, verdicts, stats_sink.get(), lopts);
+    runtime::MonitorLoop loop(*feed, verdicts, stats_sink.get(), lopts);
     SyncFlags::Sources sources = SyncFlags::open_sources(named, per_input);
     install_stop_signals();
     std::fprintf(stderr, "rvc monitor: %zu propert%s on %zu inputs (%s, sync %s) -> %zu output%s\n",
@@ -521,6 +568,8 @@ struct MonitorCommand {
       std::fprintf(stderr, "rvc: %s\n", e.what());
       return kUsage;
     }
+    if (group.given())
+      if (int status = join_group({input})) return status;
     if (check.calls && typed.given() && !ends_with(typed.type, "_Event"))
       return run_service_wire(properties, popts, verdicts, stats_sink.get());
     popts.type = typed.resolve(input_transports);
@@ -542,6 +591,7 @@ struct MonitorCommand {
     start_results({input}, properties);
 
     runtime::LoopOptions lopts = loop_options(transport::scheme_of(input) == "file");
+    lopts.join_mid_stream = group.given();
     lopts.per_publisher = transport::scheme_of(input) == "rmw_zenoh";  // GIDs: loss per publisher
     clock.open_ros_clock(lopts, transports);
     record_counters(lopts);
@@ -558,7 +608,15 @@ struct MonitorCommand {
       std::fprintf(stderr, "rvc monitor: messages that keep %s true go on to %s\n", forward_property.c_str(),
                    to.c_str());
     }
-    runtime::Feed& feed = forwarder   ? static_cast<runtime::Feed&>(*forwarder)
+    if (group.given())
+      make_sharded(
+          [&properties, popts](const std::string& shard, engine::VerdictCallback on_verdict) {
+            return std::make_unique<runtime::Pipeline>(GroupFlags::shard_properties(properties, shard), popts,
+                                                       std::move(on_verdict));
+          },
+          verdicts);
+    runtime::Feed& feed = sharded     ? static_cast<runtime::Feed&>(*sharded)
+                          : forwarder ? static_cast<runtime::Feed&>(*forwarder)
                           : call_feed ? static_cast<runtime::Feed&>(*call_feed)
                                       : pipeline;
     runtime::MonitorLoop loop(feed, verdicts, stats_sink.get(), lopts);
@@ -599,6 +657,7 @@ Runner register_monitor(CLI::App& app) {
       ->allow_extra_args(false);
   cmd->store.add_to(*sub);
   cmd->health.add_to(*sub);
+  cmd->group.add_to(*sub);
   sub->add_option("--allow", cmd->filter_options.allow,
                   "Filter (repeatable): only messages whose key (a zenoh: sample's own key) or topic matches one of "
                   "these patterns reach the monitor; '*' one chunk, '**' any chunks (docs/filter.md)");

@@ -29,6 +29,12 @@ class Feed {
   // One payload of input `input` (0 with one input); `position` names it in
   // errors (its sequence number, or line number for a file).
   virtual void feed_input(uint32_t input, std::string_view payload, uint64_t position) = 0;
+  // The same with the sample's own key (a wildcard subscriber sees many): a
+  // monitor group's feed shards by it (runtime/fleet/sharded_feed.hpp).
+  virtual void feed_keyed(uint32_t input, std::string_view key, std::string_view payload, uint64_t position) {
+    (void)key;
+    feed_input(input, payload, position);
+  }
   // The same for a recorded message: `log_time` (seconds) stands for its
   // arrival (a bag's log time).
   virtual void feed_logged(uint32_t input, std::string_view payload, uint64_t position, double log_time) {

@@ -101,7 +101,9 @@ std::string MonitorLoop::stats_json() const {
       .add("duplicates", total(&transport::SeqCounters::duplicates))
       .add("last_seq", total(&transport::SeqCounters::last_seq))
       .add("publishers", publishers)
-      .add("publisher_restarts", total(&transport::SeqCounters::restarts))
+      .add("publisher_restarts", total(&transport::SeqCounters::restarts));
+  if (options_.join_mid_stream) out.add("before_join", total(&transport::SeqCounters::before_join));
+  out
       .add("verdicts", outputs_.count())
       .add("violations", feed_.violations())
       .add("eos", eos_);
@@ -222,7 +224,7 @@ void MonitorLoop::handle(const transport::Frame& f) {
     }
     if (options_.filter->projecting() && options_.filter->project(payload, projected_)) payload = projected_;
   }
-  feed_.feed_input(f.input, payload, f.seq ? f.seq : counters.received);
+  feed_.feed_keyed(f.input, f.key, payload, f.seq ? f.seq : counters.received);
 }
 
 void MonitorLoop::on_schedule(std::chrono::steady_clock::time_point now) {
@@ -339,7 +341,10 @@ void MonitorLoop::process(const std::vector<transport::Source*>& sources) {
   counters_.assign(sources.size(), transport::SeqCounters{});
   input_eos_.assign(sources.size(), false);
   input_last_.assign(sources.size(), std::chrono::steady_clock::now());
-  for (auto& c : counters_) c.expect(options_.publishers);
+  for (auto& c : counters_) {
+    c.expect(options_.publishers);
+    if (options_.join_mid_stream) c.join_mid_stream();
+  }
   last_stats_ = last_record_ = last_tick_ = std::chrono::steady_clock::now();
   clock_ = StreamClock(options_.clock, options_.time);
   // Deadlines are met to the timer's precision: the kernel may defer a

@@ -52,6 +52,9 @@ struct LoopOptions {
   // tell the publishers of a topic apart.
   bool per_publisher = false;
   bool exit_on_eos = false;      // stop at the publisher's end-of-stream marker
+  // A publisher's first sequence number past 1 is where this monitor joined
+  // it, not a gap (a monitor group's replica started mid-run, docs/fleet.md).
+  bool join_mid_stream = false;
   // With exit_on_eos: how many publishers' markers end the stream. A publisher
   // the monitor has not discovered yet when the others end cannot be waited
   // for otherwise (discovery is asynchronous on both DDS and Zenoh).

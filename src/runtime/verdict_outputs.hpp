@@ -8,6 +8,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "engine/checker.hpp"
@@ -69,6 +70,10 @@ class VerdictOutputs {
   // The end-of-stream marker, then a flush, on every sink. Throws as put().
   void finish();
 
+  // Extra JSON members for the verdicts put until the next call (",\"handover\":true"
+  // while a group replica replays a shard it took over); "" for none. JSON sinks only.
+  void set_mark(std::string_view members) { mark_ = members; }
+
   uint64_t count() const { return count_; }
   size_t size() const { return sinks_.size(); }
   transport::Sink& sink(size_t i) { return *sinks_[i]; }
@@ -78,6 +83,7 @@ class VerdictOutputs {
   bool discrete_;
   uint64_t count_ = 0;
   std::string line_, sample_;
+  std::string_view mark_;
   const msg::MessageType* type_ = nullptr;
   std::vector<bool> typed_;
   std::vector<std::function<void(const engine::Verdict&)>> observers_;

@@ -23,6 +23,14 @@ class SeqCounters {
   uint64_t rejected = 0;    // payloads the decoder refused (set by the pipeline)
   uint64_t last_seq = 0;    // messages announced: the sum of each publisher's last sequence number
   uint64_t restarts = 0;    // a publisher that began again (from 1, or a new one after an end of stream)
+  // join_mid_stream(): the numbers a publisher had sent before its first one
+  // reached this subscriber (not lost: sent before it joined).
+  uint64_t before_join = 0;
+
+  // A subscriber that joins publishers already running (a monitor group's
+  // replica started or restarted mid-run, docs/fleet.md): a publisher's
+  // first sequence number past 1 is where it joined, not a gap.
+  void join_mid_stream() { join_mid_stream_ = true; }
 
   // One message; `publisher` identifies its sender (0: unknown — counted, not
   // accounted). seq 0: the publisher sent no sequence number.
@@ -55,6 +63,7 @@ class SeqCounters {
   size_t ended_ = 0;
   bool any_ended_ = false;  // some publisher ended: a newcomer after it is a restart
   size_t expected_ = 1;
+  bool join_mid_stream_ = false;
 };
 
 // Header-only: the transports' own test probes use it without the rest of rvc.
@@ -81,8 +90,14 @@ inline SeqCounters::Publisher& SeqCounters::publisher(uint64_t id, uint64_t seq)
 inline void SeqCounters::on_seq(uint64_t seq, uint64_t id) {
   ++received;
   if (seq == 0) return;  // publisher sent no sequence number
+  const bool first = join_mid_stream_ && by_publisher_.find(id) == by_publisher_.end();
   Publisher& p = publisher(id, seq);
   ++p.received;
+  if (first && seq > 1) {
+    before_join += seq - 1;
+    last_seq += seq - 1;
+    p.last_seq = seq - 1;
+  }
   if (seq <= p.last_seq) {
     ++duplicates;
     ++p.duplicates;

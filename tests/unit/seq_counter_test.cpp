@@ -86,3 +86,23 @@ TEST(SeqCounters, UnnumberedMessagesAreCountedOnly) {
 
 }  // namespace
 }  // namespace rvc::transport
+
+// A monitor group's replica started mid-run (docs/fleet.md): a publisher's
+// first number past 1 is where it joined, not a gap; gaps after it still count.
+TEST(SeqCounters, JoiningMidStreamCountsTheNumbersBeforeAsBeforeJoinNotAsGaps) {
+  rvc::transport::SeqCounters c;
+  c.join_mid_stream();
+  c.on_seq(41, 7);
+  c.on_seq(42, 7);
+  c.on_seq(44, 7);
+  c.on_seq(1, 8);
+  EXPECT_EQ(c.received, 4u);
+  EXPECT_EQ(c.before_join, 40u);
+  EXPECT_EQ(c.gaps, 1u);
+  EXPECT_EQ(c.last_seq, 45u);  // 44 + 1: every number announced
+  c.on_eos(44, 7);
+  EXPECT_EQ(c.gaps, 1u);
+  rvc::transport::SeqCounters plain;  // without it the same start is 40 lost
+  plain.on_seq(41, 7);
+  EXPECT_EQ(plain.gaps, 40u);
+}

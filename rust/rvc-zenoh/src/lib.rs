@@ -1074,3 +1074,91 @@ pub unsafe extern "C" fn rvc_zenoh_liveliness_get(
         Ok(n)
     })
 }
+
+// ---------------------------------------------------------------------------
+// Liveliness subscriber (a group's member set: rvc monitor --group)
+// ---------------------------------------------------------------------------
+
+/// `alive` is 1 when the token appeared (or was alive at declaration, with
+/// history), 0 when it went (undeclared, or its session's lease expired).
+pub type rvc_zenoh_liveliness_cb =
+    unsafe extern "C" fn(key: *const u8, key_len: usize, alive: c_int, ctx: *mut c_void);
+
+struct LivelinessTarget {
+    cb: rvc_zenoh_liveliness_cb,
+    ctx: *mut c_void,
+    /// As CallbackTarget::active: undeclare fences the callbacks.
+    active: RwLock<bool>,
+}
+
+// SAFETY: the C side promises `cb` may be called from any thread with `ctx`.
+unsafe impl Send for LivelinessTarget {}
+unsafe impl Sync for LivelinessTarget {}
+
+pub struct rvc_zenoh_liveliness_subscriber {
+    target: Arc<LivelinessTarget>,
+    subscriber: Option<Subscriber<()>>,
+}
+
+/// Subscribes to the liveliness tokens matching `key`: `cb` runs on a Zenoh
+/// thread for each token that appears or goes; `history` != 0 also reports
+/// the tokens alive at declaration.
+#[no_mangle]
+pub unsafe extern "C" fn rvc_zenoh_liveliness_subscribe(
+    s: *const rvc_zenoh_session,
+    key: *const c_char,
+    history: c_int,
+    cb: Option<rvc_zenoh_liveliness_cb>,
+    ctx: *mut c_void,
+    out: *mut *mut rvc_zenoh_liveliness_subscriber,
+) -> c_int {
+    guard(|| {
+        let s = handle(s, "session")?;
+        let ke = keyexpr(cstr(key, "keyexpr")?)?;
+        let cb = cb.ok_or_else(|| einval("callback is NULL"))?;
+        let out = out_ptr(out, "out")?;
+        let target = Arc::new(LivelinessTarget { cb, ctx, active: RwLock::new(true) });
+        let t = target.clone();
+        let subscriber = s
+            .session
+            .liveliness()
+            .declare_subscriber(ke.clone())
+            .history(history != 0)
+            .callback(move |sample: Sample| {
+                let active = t.active.read().unwrap_or_else(|p| p.into_inner());
+                if !*active {
+                    return;
+                }
+                let k = sample.key_expr().as_str();
+                let alive = (sample.kind() == SampleKind::Put) as c_int;
+                // SAFETY: the key is borrowed for the call only.
+                unsafe { (t.cb)(k.as_ptr(), k.len(), alive, t.ctx) };
+            })
+            .wait()
+            .map_err(|e| ezenoh(&format!("declaring liveliness subscriber on '{ke}'"), e))?;
+        *out = Box::into_raw(Box::new(rvc_zenoh_liveliness_subscriber {
+            target,
+            subscriber: Some(subscriber),
+        }));
+        Ok(RVC_ZENOH_OK)
+    })
+}
+
+/// After return no callback is running or will run. Frees the handle.
+#[no_mangle]
+pub unsafe extern "C" fn rvc_zenoh_liveliness_unsubscribe(sub: *mut rvc_zenoh_liveliness_subscriber) -> c_int {
+    if sub.is_null() {
+        return RVC_ZENOH_OK;
+    }
+    guard(|| {
+        // SAFETY: produced by Box::into_raw in subscribe; freed once here.
+        let mut sub = unsafe { Box::from_raw(sub) };
+        *sub.target.active.write().unwrap_or_else(|p| p.into_inner()) = false;
+        if let Some(s) = sub.subscriber.take() {
+            s.undeclare()
+                .wait()
+                .map_err(|e| ezenoh("undeclaring liveliness subscriber", e))?;
+        }
+        Ok(RVC_ZENOH_OK)
+    })
+}

@@ -146,6 +146,21 @@ typedef void (*rvc_zenoh_key_cb)(const uint8_t* key, size_t key_len, void* ctx);
 int rvc_zenoh_liveliness_get(const rvc_zenoh_session* s, const char* keyexpr, uint64_t timeout_ms,
                              rvc_zenoh_key_cb cb, void* ctx);
 
+/* ---- liveliness subscriber -------------------------------------------- */
+
+/* alive: 1 the token appeared (or was alive at declaration, with history),
+ * 0 it went (undeclared, or its session's lease expired). Zenoh thread; key
+ * borrowed for the call; must return quickly and not throw. */
+typedef void (*rvc_zenoh_liveliness_cb)(const uint8_t* key, size_t key_len, int alive, void* ctx);
+typedef struct rvc_zenoh_liveliness_subscriber rvc_zenoh_liveliness_subscriber;
+/* The tokens matching keyexpr as they come and go (rvc monitor --group: the
+ * members "@rvc/group/<NAME>/<replica>"); history != 0 also reports those
+ * alive now. */
+int rvc_zenoh_liveliness_subscribe(const rvc_zenoh_session* s, const char* keyexpr, int history,
+                                   rvc_zenoh_liveliness_cb cb, void* ctx, rvc_zenoh_liveliness_subscriber** out);
+/* After return no callback is running or will run. Not from inside cb. */
+int rvc_zenoh_liveliness_unsubscribe(rvc_zenoh_liveliness_subscriber* sub);
+
 #ifdef __cplusplus
 }
 #endif

@@ -1,0 +1,43 @@
+// Sharding a fleet's key space over the replicas of a monitor group
+// (`rvc monitor --group NAME --shard-by 'fleet/*'`, docs/fleet.md).
+//
+// The shard of a sample is the prefix of its key that the --shard-by pattern
+// covers: `fleet/*` makes `fleet/v07/vehicle/status/gear_status` shard
+// `fleet/v07`. Each shard is owned by exactly one member of the group: the
+// one with the highest rendezvous (highest-random-weight) hash of
+// (member, shard). Every replica computes the same owner from the same member
+// set, and when a member leaves only its own shards move.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace rvc::runtime::fleet {
+
+class ShardPattern {
+ public:
+  // Chunks separated by '/', each literal or '*' (one chunk). Throws
+  // std::invalid_argument for an empty pattern, an empty chunk or '**'.
+  explicit ShardPattern(const std::string& pattern);
+  // The key's first chunks that the pattern matches, or nullopt when the key
+  // is shorter or a literal chunk differs.
+  std::optional<std::string_view> shard_of(std::string_view key) const;
+  const std::string& text() const { return text_; }
+
+ private:
+  std::string text_;
+  std::vector<std::string> chunks_;
+};
+
+// A 64-bit hash that is the same in every process and on every host (FNV-1a
+// with a final avalanche): owners must agree across replicas.
+uint64_t stable_hash(std::string_view a, std::string_view b);
+
+// The owner of `shard` among `members` (rendezvous hashing); "" when there
+// are none. Ties (equal hashes) go to the smaller member id.
+std::string owner_of(std::string_view shard, const std::vector<std::string>& members);
+
+}  // namespace rvc::runtime::fleet
