@@ -115,7 +115,7 @@ def render(rows, args):
            f"Python {platform.python_version()}, {platform.machine()}, load {load:.1f} at the end "
            f"(`bench/python_bench.py`). Events per second of the whole loop (k = 1000).\n\n",
            "| file | reelay update() | rvc update() | rvc / reelay | rvc update_many(list) | rvc update_many(numpy) "
-           "| boundary ns/call | same verdicts |\n", "|---|---:|---:|---:|---:|---:|---:|---|\n"]
+           "| boundary ns/call | same changes |\n", "|---|---:|---:|---:|---:|---:|---:|---|\n"]
     for r in rows:
         out.append(f"| {r['file']} | {r['reelay_keps']:.0f} k | {r['rvc_keps']:.0f} k | "
                    f"{r['rvc_keps'] / r['reelay_keps']:.2f}x | {r['many_keps']:.0f} k | {r['numpy_keps']:.0f} k | "
