@@ -21,7 +21,7 @@ m = rvc.discrete_timed_monitor(pattern="historically[0:2]({p})")
 out = [m.update({"p": v}) for v in (True, True, False, False, True, True, True)]
 # hand-computed: false from step 2 (p fails there) until step 6 (steps 4..6 all hold p)
 assert out == [{"time": 0, "value": True}, {}, {"time": 2, "value": False}, {}, {}, {}, {"time": 6, "value": True}], out
-print("clean venv: pip install of", sys.argv[0] or "the wheel", "and a check: ok")
+print("clean venv: the wheel pip-installed alone, a hand-computed check: ok")
 PYEOF
 )
 
