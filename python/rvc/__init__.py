@@ -11,10 +11,10 @@ Two APIs over one engine (docs/python.md):
 """
 from __future__ import annotations
 
-from ._rvc import DenseTimedMonitor, DiscreteTimedMonitor
+from ._rvc import DenseTimedMonitor, DiscreteTimedMonitor, has_mcap
 from .monitor import BagResult, Monitor, Verdict, check_bag, to_dataframe
 
-__all__ = ["discrete_timed_monitor", "dense_timed_monitor", "Monitor", "Verdict", "BagResult", "check_bag", "to_dataframe"]
+__all__ = ["discrete_timed_monitor", "dense_timed_monitor", "Monitor", "Verdict", "BagResult", "check_bag", "to_dataframe", "has_mcap"]
 __version__ = "0.1.0"
 
 

@@ -167,8 +167,8 @@ class BagResult:
 def check_bag(path, properties: Properties, *, topic: Optional[str] = None, dense: bool = False,
               robustness: bool = False, explain: bool = False, all: bool = False,
               msg_path: Sequence[str] = ()) -> BagResult:
-    """Checks one topic of a ROS 2 bag (a .db3 file or a bag folder; MCAP where the package was
-    built with it) as `rvc check BAG --topic TOPIC` does: the types from the bag's schemas,
+    """Checks one topic of a ROS 2 bag (MCAP, a .db3 file or a bag folder; MCAP needs a package
+    built with it: rvc.has_mcap) as `rvc check BAG --topic TOPIC` does: the types from the bag's schemas,
     messages in the bag's order. topic may be left out when the bag has one topic."""
     r = _rvc.check_bag(os.fspath(path), _properties(properties), topic or "", dense, robustness, explain, all,
                        [os.fspath(p) for p in msg_path])

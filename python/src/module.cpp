@@ -180,6 +180,11 @@ NB_MODULE(_rvc, m) {
       PyErr_SetString(PyExc_ValueError, e.what());
     }
   });
+#ifdef RVC_HAVE_MCAP
+  m.attr("has_mcap") = true;  // check_bag reads MCAP bags (built with the Rust library)
+#else
+  m.attr("has_mcap") = false;
+#endif
   bind_reelay(m);
   bind_session(m);
   bind_bag(m);

@@ -124,19 +124,23 @@ def test_update_cdr_reads_rosbags_bytes(humble):
         ours.update_cdr("std_msgs/msg/Bool", b"\x00\x01\x00\x00\x01")
 
 
-def write_bag(path, humble, values):
+def write_bag(path, humble, values, storage="sqlite3"):
     from rosbags.rosbag2 import StoragePlugin, Writer
     Float64 = humble.types["std_msgs/msg/Float64"]
-    with Writer(path, version=8, storage_plugin=StoragePlugin.SQLITE3) as w:
+    plugin = StoragePlugin.SQLITE3 if storage == "sqlite3" else StoragePlugin.MCAP
+    with Writer(path, version=8, storage_plugin=plugin) as w:
         c = w.add_connection("/speed", Float64.__msgtype__, typestore=humble)
         for i, v in enumerate(values):
             w.write(c, 1_000_000_000 + i * 100_000_000, humble.serialize_cdr(Float64(data=v), Float64.__msgtype__))
 
 
-def test_check_bag_verdicts_and_counts(humble, tmp_path):
+@pytest.mark.parametrize("storage", ["sqlite3", "mcap"])
+def test_check_bag_verdicts_and_counts(humble, tmp_path, storage):
+    if storage == "mcap" and not rvc.has_mcap:
+        pytest.skip("this wheel was built without MCAP (RVC_WHEEL_MCAP=0 or no cargo)")
     rng = random.Random(45)
     values = [rng.choice([5.0, 12.5, 29.0, 31.0]) for _ in range(80)]
-    write_bag(tmp_path / "drive", humble, values)
+    write_bag(tmp_path / "drive", humble, values, storage)
     props = {"slow": "{data < 30}", "calm": "historically[0:2]({data < 30}) or once[0:1]({data < 10})"}
     r = rvc.check_bag(tmp_path / "drive", props)
     assert (r.topic, r.type, r.messages, r.received, r.checked, r.rejected) == (
