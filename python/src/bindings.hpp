@@ -3,6 +3,7 @@
 
 #include <nanobind/nanobind.h>
 
+#include <stdexcept>
 #include <string>
 
 #include "session.hpp"
@@ -11,7 +12,12 @@ namespace rvc::python {
 
 namespace nb = nanobind;
 
-// The message `obj` (a dict) as a JSON line in `line`; TypeError if it cannot be one.
+// A message with a value JSON cannot hold; Python's TypeError.
+struct UnjsonableMessage : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// The message `obj` (a dict) as a JSON line in `line`; UnjsonableMessage if it cannot be one.
 void to_json_line(std::string& line, nb::handle obj);
 // The session's warnings (a field that kept its value) as Python RuntimeWarnings.
 void emit_warnings(Session& session);

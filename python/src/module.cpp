@@ -19,7 +19,7 @@ namespace rvc::python {
 void to_json_line(std::string& line, nb::handle obj) {
   line.clear();
   std::string error;
-  if (!append_py_json(line, obj.ptr(), error)) throw nb::type_error(error.c_str());
+  if (!append_py_json(line, obj.ptr(), error)) throw UnjsonableMessage(error);
 }
 
 void emit_warnings(Session& session) {
@@ -57,8 +57,15 @@ nb::list feed_batch(Session& s, size_t count, Fill&& fill) {
   nb::list out;
   std::string line;
   s.captured().clear();
+  std::vector<std::string> refused;
   for (size_t i = 0; i < count; ++i) {
-    fill(line, i);
+    try {
+      fill(line, i);
+    } catch (const UnjsonableMessage& e) {  // a value JSON cannot hold: this message only
+      s.refuse();
+      refused.push_back("message " + std::to_string(s.messages()) + ": " + e.what() + " (message skipped)");
+      continue;
+    }
     s.feed_lenient(line);
     for (const Captured& c : s.captured()) {
       nb::tuple t = verdict_tuple(c, s.options());
@@ -66,6 +73,8 @@ nb::list feed_batch(Session& s, size_t count, Fill&& fill) {
     }
     s.captured().clear();
   }
+  for (const std::string& r : refused)
+    if (PyErr_WarnEx(PyExc_RuntimeWarning, r.c_str(), 2) != 0) throw nb::python_error();
   for (const std::string& r : s.take_rejections())
     if (PyErr_WarnEx(PyExc_RuntimeWarning, r.c_str(), 2) != 0) throw nb::python_error();
   emit_warnings(s);
@@ -99,7 +108,12 @@ void bind_session(nb::module_& m) {
       .def("update",
            [](Session& s, nb::handle message) {
              std::string line;
-             to_json_line(line, message);
+             try {
+               to_json_line(line, message);
+             } catch (const UnjsonableMessage&) {
+               s.refuse();  // counted, as a refused message is; the monitors do not move
+               throw;
+             }
              s.captured().clear();
              s.feed(line);
              emit_warnings(s);
@@ -157,7 +171,7 @@ void bind_session(nb::module_& m) {
         nb::dict d;
         d["messages"] = s.messages();
         d["checked"] = s.stats().accepted;
-        d["rejected"] = s.stats().rejected;
+        d["rejected"] = s.rejected();
         d["warnings"] = s.stats().warnings;
         d["violations"] = s.violations();
         return d;
@@ -178,6 +192,8 @@ NB_MODULE(_rvc, m) {
       PyErr_SetString(PyExc_ValueError, e.what());
     } catch (const RejectedMessage& e) {
       PyErr_SetString(PyExc_ValueError, e.what());
+    } catch (const UnjsonableMessage& e) {
+      PyErr_SetString(PyExc_TypeError, e.what());
     }
   });
 #ifdef RVC_HAVE_MCAP

@@ -54,6 +54,12 @@ class Session {
   // The same, but a refused message is only counted and its text kept in
   // take_rejections() (update_many: one bad message costs only itself).
   bool feed_lenient(std::string_view payload);
+  // A message refused before it reached the pipeline (a value JSON cannot
+  // hold): counted as given and rejected, so the counts still add up.
+  void refuse() {
+    ++position_;
+    ++refused_;
+  }
   // Dense time: an empty message at `t` (docs/semantics.md, "Ticks").
   void tick(double t);
 
@@ -65,7 +71,8 @@ class Session {
   uint64_t violations() const { return pipeline_->violations(); }
   const std::vector<std::string>& names() const { return pipeline_->checker().names(); }
   const SessionOptions& options() const { return options_; }
-  uint64_t messages() const { return position_; }  // given to feed, refused ones included
+  uint64_t messages() const { return position_; }  // given, refused ones included
+  uint64_t rejected() const { return pipeline_->stats().rejected + refused_; }
   double clock() const { return pipeline_->checker().clock(); }
   bool has_data_references() const { return pipeline_->checker().has_data_references(); }
 
@@ -79,6 +86,7 @@ class Session {
   std::vector<std::string> warnings_, rejections_;
   std::unique_ptr<runtime::Pipeline> pipeline_;
   uint64_t position_ = 0;
+  uint64_t refused_ = 0;
 };
 
 }  // namespace rvc::python

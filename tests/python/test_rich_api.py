@@ -81,6 +81,20 @@ def test_bad_message_in_a_batch_costs_only_itself():
     assert m.stats == {"messages": 4, "checked": 3, "rejected": 1, "warnings": 0, "violations": 2}
 
 
+def test_value_json_cannot_hold_costs_only_its_message():
+    m = rvc.Monitor("{p}", all=True)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        out = m.update_many([{"p": True}, {"p": b"raw"}, {"p": False}])
+    assert [str(w.message) for w in caught] == [
+        "message 2: field p: a value of type bytes (messages hold bool, int, float, str, None, dict, list)"
+        " (message skipped)"]
+    assert [(v.index, v.time, v.value) for v in out] == [(0, 0, True), (2, 1, False)]
+    with pytest.raises(TypeError, match="bytes"):
+        m.update({"p": b"raw"})
+    assert m.stats == {"messages": 4, "checked": 2, "rejected": 2, "warnings": 0, "violations": 1}
+
+
 def test_explain_says_why():
     m = rvc.Monitor({"limit": "historically({x < 3})", "echo": "{p}"}, explain=True)
     assert [v.explanation for v in m.update({"x": 1, "p": True})] == [None, None]
