@@ -33,6 +33,7 @@ TEST_APT_PACKAGES=(
   postgresql                            # a real PostgreSQL server (tests start their own)
   chromium                              # the dashboard's browser tests (Playwright drives it)
   python3-pip
+  python3-dev python3-venv  # the Python package: its extension's headers, the fresh venvs tests/python/run.sh makes
   iproute2 time
   clang libclang-rt-14-dev  # libFuzzer harnesses and the sanitizer tiers (tests/fuzz)
   libclang1-14              # tools/ros2dds-bridge: cyclors' bindgen loads libclang at build time (cmake: above)
@@ -66,11 +67,12 @@ fi
 # Zenoh binding, CycloneDDS's Python binding, rosbags (ROS 2 CDR and rosbag2 bags),
 # Foxglove's MCAP writer with its chunk compressions (zstd, lz4), pytest; rvc-batch's engine
 # (Dask's distributed scheduler) and progress bar (tqdm); kubernetes-validate (the offline check of
-# deploy/k8s against the Kubernetes API schemas); RTAMT (the STL oracle).
+# deploy/k8s against the Kubernetes API schemas); RTAMT (the STL oracle); the Python package's
+# build (scikit-build-core, nanobind: scripts/build-wheel.sh) and pandas (its DataFrames).
 PY=${PYTHON:-python3}
 PIP_PACKAGES=(pytest "reelay==25.0.0" "eclipse-zenoh==1.10.2" "cyclonedds==11.0.1" "rosbags==0.11.9" matplotlib
   "mcap==1.6.0" "zstandard==0.25.0" "lz4==4.4.5" "dask==2026.8.0" "distributed==2026.8.0" "tqdm==4.70.1"
-  "kubernetes-validate==1.37.0" "rtamt==0.4.10")
+  "kubernetes-validate==1.37.0" "rtamt==0.4.10" "scikit-build-core==1.1.2" "nanobind==3.1.0" "pandas==3.1.1")
 if ! "$PY" - "${PIP_PACKAGES[@]}" <<'PYEOF' 2>/dev/null
 import sys
 from importlib.metadata import version, PackageNotFoundError

@@ -155,6 +155,7 @@ Pipeline::Pipeline(const engine::AtomTable& atoms, const PipelineOptions& option
 }
 
 void Pipeline::report(const std::string& text) {
+  if (options_.on_report) return options_.on_report(text);
   if (reported_++ < options_.max_reported) std::fprintf(stderr, "rvc: %s\n", text.c_str());
 }
 

@@ -52,6 +52,9 @@ struct PipelineOptions {
   // text (a JSON line, or a CDR sample) and its position.
   std::function<void(std::string_view input, std::string_view text, uint64_t position)> on_message;
   std::string input_name;  // what on_message calls this input
+  // Where each error and warning line goes (without the "rvc: " prefix); empty: stderr, at most
+  // max_reported of them. The Python package (python/) turns them into exceptions and warnings.
+  std::function<void(const std::string& text)> on_report;
 };
 
 // Decode-only mode (a synchronized input, see SyncedPipeline): each accepted
