@@ -1,5 +1,6 @@
 #include "runtime/verdict_outputs.hpp"
 
+#include <cmath>
 #include <stdexcept>
 
 #include "io/cdr_codec.hpp"
@@ -13,6 +14,7 @@ void VerdictOutputs::put(const engine::Verdict& v) {
   line_.clear();
   if (v.robust) io::append_robustness(line_, v.time, discrete_, v.property, v.robustness);
   else io::append_verdict(line_, v.time, discrete_, v.property, v.value);
+  if (!std::isnan(v.known_at) && !type_) io::append_known_at(line_, v.known_at);
   if (v.explanation && !type_) {  // {"time":..,"value":false,"explain":["...", ...]} (typed verdicts have no field for it)
     line_.resize(line_.size() - 2);  // "}\n"
     line_ += ",\"explain\":[";
