@@ -173,21 +173,25 @@ void Checker::finish() {
   }
   // Dense time: the stream covers [0, clock). A tick at the clock (the end
   // tick of a recording) told the value at that instant too: it stays part
-  // of the stream, and the windows are cut just after it.
-  end_ = end_known_ = clock_;
-  const double cut = told_at_ == clock_ ? std::nextafter(clock_, std::numeric_limits<double>::infinity()) : clock_;
+  // of the stream, and the windows are cut just after it, 1e-9 (relative)
+  // later: a gap that bounds added to it do not round away.
+  const double cut = told_at_ == clock_ ? clock_ + 1e-9 * std::max(1.0, std::abs(clock_)) : clock_;
+  end_ = cut;
+  end_known_ = clock_;
+  // Up to and with clock + delay (cut + delay may round down to it).
+  const double until = std::nextafter(cut + max_delay_, std::numeric_limits<double>::infinity());
   if (robustness_) {
     if (last_margins_.empty()) last_margins_.assign(atoms_.size(), -std::numeric_limits<double>::infinity());
     std::vector<double> margins = last_margins_;
     if (cut > clock_) step_robust(clock_, cut, margins.data());
     margins[end] = std::numeric_limits<double>::infinity();
-    step_robust(cut, cut + max_delay_, margins.data());
+    step_robust(cut, until, margins.data());
   } else {
     if (last_atoms_.empty()) last_atoms_.assign(atoms_.size(), 0);
     std::vector<uint8_t> atoms = last_atoms_;
     if (cut > clock_) step(clock_, cut, atoms.data());
     atoms[end] = 1;
-    step(cut, cut + max_delay_, atoms.data());
+    step(cut, until, atoms.data());
   }
 }
 
