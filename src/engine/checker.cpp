@@ -134,6 +134,13 @@ bool Checker::refer(size_t i, double& time, double& known, double value) {
     stash_[i] = std::numeric_limits<double>::quiet_NaN();
     known = finished_ ? std::min(time, end_known_) : time;  // settled: known when the stream ended
     time -= d;
+    // Dense time: 1.2 - 1 is 0.19999999999999996; stamps are written with
+    // at most nanoseconds, so a difference within rounding error of a whole
+    // nanosecond is that nanosecond.
+    if (model_ == TimeModel::Dense) {
+      const double ns = std::round(time * 1e9) / 1e9;
+      if (std::abs(ns - time) <= 1e-12 * std::max(1.0, std::abs(time))) time = ns;
+    }
   }
   return time < end_;
 }
@@ -407,8 +414,11 @@ double Checker::next_deadline(const uint8_t* atoms, const uint32_t* bound) {
   if (model_ != TimeModel::Dense) return kNever;  // discrete time has no clock: steps are messages
   double next = kNever;
   for (size_t i = 0; i < where_.size(); ++i) {
-    const bool v = value_at_clock(i, atoms, bound);
-    if (emit_all_ ? told_at_ != clock_ : last_[i] != static_cast<int8_t>(v)) return clock_;  // not told yet
+    const bool v = value_at_clock(i, atoms, bound);  // first: next_change reads what it computed
+    // A delayed property's value before its delay is about no instant of the
+    // stream: its first verdict (for 0) is due at the delay.
+    if (clock_ < delay_[i]) next = std::min(next, delay_[i]);
+    else if (emit_all_ ? told_at_ != clock_ : last_[i] != static_cast<int8_t>(v)) return clock_;  // not told yet
     const auto [kind, k] = where_[i];
     const double t = kind == kData ? dense_data_[k].next_change(clock_) : dense_[k].next_change(clock_);
     if (t < next) next = t;
@@ -422,7 +432,8 @@ double Checker::next_deadline_robust(const double* margins) {
   double next = kNever;
   for (size_t i = 0; i < robust_dense_.size(); ++i) {
     const double r = robust_dense_[i].at(clock_, margins);
-    if (!(r == last_robustness_[i])) return clock_;  // not told yet
+    if (clock_ < delay_[i]) next = std::min(next, delay_[i]);  // as in next_deadline
+    else if (!(r == last_robustness_[i])) return clock_;  // not told yet
     const double t = robust_dense_[i].next_change(clock_);
     if (t < next) next = t;
   }
