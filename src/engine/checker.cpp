@@ -97,6 +97,14 @@ spec::NodePtr Checker::pastified(const spec::Node& ast, double h, const std::str
   if (has_quantifier(ast))
     throw spec::SpecError("bounded future (eventually, always, until, next) with exists/forall is not supported yet",
                           source, 1);
+  // The end of a discrete stream settles a verdict per step of the horizon
+  // (finish): bounded so that ending a run never takes minutes.
+  constexpr double kMaxDiscreteHorizon = 1e7;
+  if (model_ == TimeModel::Discrete && h > kMaxDiscreteHorizon)
+    throw spec::SpecError("the future horizon is " + std::to_string(static_cast<uint64_t>(h)) +
+                              " steps; discrete time allows up to 10000000 (the verdicts of the last horizon are "
+                              "settled one step each at the end of the stream)",
+                          source, 1);
   if (end_atom_ < 0) {
     spec::FieldTest end;
     end.path = {kEndMarkerField};
