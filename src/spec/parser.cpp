@@ -48,8 +48,7 @@ class Parser {
     check_height(*node);
     if (!at_end()) {
       if (peek() == ')') fail("unmatched ')'", pos_);
-      if (peek_word("since") || peek_word("S") || peek_word("until"))
-        fail("chained 'since'/'until' is ambiguous: add parentheses, e.g. (a since b) since c", pos_);
+      refuse_chain();
       fail("unexpected '" + std::string(1, peek()) + "' after a complete formula (missing operator?)", pos_);
     }
     return node;
@@ -286,8 +285,7 @@ class Parser {
       NodePtr inner = parse_quantified();
       skip_ws();
       if (peek() != ')') {
-        if (peek_word("since") || peek_word("S") || peek_word("until"))
-          fail("chained 'since'/'until' is ambiguous: add parentheses, e.g. (a since b) since c", pos_);
+        refuse_chain();
         fail(at_end() ? "missing ')' to close the '(' at column " + column_text(at)
                       : "expected ')' to close the '(' at column " + column_text(at),
              pos_);
@@ -308,6 +306,15 @@ class Parser {
       fail("unknown word '" + word + "': atoms are written in braces, e.g. {" + word + "}", pos_);
     }
     fail("unexpected '" + std::string(1, c) + "': expected a formula", pos_);
+  }
+
+  // After a complete since/until: another one needs parentheses (Reelay
+  // silently drops the last part of `a since b since c`).
+  void refuse_chain() const {
+    if (peek_word("since") || peek_word("S"))
+      fail("chained 'since' is ambiguous: add parentheses, e.g. (a since b) since c", pos_);
+    if (peek_word("until"))
+      fail("chained 'until' is ambiguous: add parentheses, e.g. (a until[0:1] b) until[0:1] c", pos_);
   }
 
   // A future operator is monitored with a delay equal to its horizon

@@ -123,7 +123,7 @@ def test_refusals(rvc, tmp_path):
         (["next {p}"], ["--dense"], "'next' has no meaning in dense time"),
         (["{p} until[0:1] {q}"], ["--dense"], "'until' is not supported in dense time"),
         (["({p} until[0:1] {q}) until[0:1] {p}"], [], None),
-        (["{p} until[0:1] {q} until[0:1] {p}"], [], "chained 'since'/'until' is ambiguous"),
+        (["{p} until[0:1] {q} until[0:1] {p}"], [], "chained 'until' is ambiguous"),
         (["{p} until[0:300] {q}"], [], "until[a:b] with b - a >= 256"),
         (["exists[x]. eventually[0:1] {id: *x}"], [], "with exists/forall is not supported"),
     ]

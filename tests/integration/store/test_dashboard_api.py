@@ -34,10 +34,11 @@ SCHEMA = [
     "started_at DOUBLE PRECISION, ended_at DOUBLE PRECISION, exit_status INTEGER, end_reason TEXT, counters TEXT)",
     "CREATE TABLE IF NOT EXISTS properties (run TEXT NOT NULL, name TEXT NOT NULL, spec TEXT, PRIMARY KEY (run, name))",
     "CREATE TABLE IF NOT EXISTS verdicts (id INTEGER PRIMARY KEY AUTOINCREMENT, run TEXT NOT NULL, "
-    "property TEXT NOT NULL, time DOUBLE PRECISION, value INTEGER, wall DOUBLE PRECISION)",
+    "property TEXT NOT NULL, time DOUBLE PRECISION, value INTEGER, wall DOUBLE PRECISION, known_at DOUBLE PRECISION)",
     "CREATE INDEX IF NOT EXISTS verdicts_by_run ON verdicts (run, property, id)",
     "CREATE TABLE IF NOT EXISTS violations (id INTEGER PRIMARY KEY AUTOINCREMENT, run TEXT NOT NULL, "
-    "property TEXT NOT NULL, time DOUBLE PRECISION, wall DOUBLE PRECISION, witness TEXT, explanation TEXT)",
+    "property TEXT NOT NULL, time DOUBLE PRECISION, wall DOUBLE PRECISION, witness TEXT, explanation TEXT, "
+    "known_at DOUBLE PRECISION)",
     "CREATE INDEX IF NOT EXISTS violations_by_run ON violations (run, id)",
     "CREATE TABLE IF NOT EXISTS counters (id INTEGER PRIMARY KEY AUTOINCREMENT, run TEXT NOT NULL, "
     "wall DOUBLE PRECISION, counters TEXT)",
@@ -55,6 +56,11 @@ SNAPSHOTS = [  # run r-live: (wall, counters) for two inputs, interleaved
     (3003.0, {"input": "a", "received": 300, "checked": 290, "gaps": 2}),
     (3005.5, {"input": "b", "received": 60, "checked": 60, "gaps": 1}),
 ]
+
+
+def older(sql):
+    """A CREATE statement as an rvc before explanations and known_at (bounded future) wrote it."""
+    return sql.replace(", known_at DOUBLE PRECISION)", ")").replace(", explanation TEXT)", ")")
 
 
 def execute(path, sql, params=()):
@@ -551,7 +557,7 @@ def test_explanations_kept_and_an_older_database_gains_their_column(tmp_path):
     db = tmp_path / "old.db"
     with sqlite3.connect(db) as c:
         for sql in SCHEMA:
-            c.execute(sql.replace(", explanation TEXT)", ")"))
+            c.execute(older(sql))
     trace = tmp_path / "t.jsonl"
     trace.write_text("".join(json.dumps({"speed": s}) + "\n" for s in [10, 50]))
     r = subprocess.run([rvc_binary(), "check", "--explain", "-s", "{speed < 40}", "--output", f"sqlite:{db}",
@@ -573,7 +579,7 @@ def test_an_older_database_is_served_as_it_is(tmp_path):
     db = tmp_path / "old.db"
     with sqlite3.connect(db) as c:
         for sql in SCHEMA:
-            c.execute(sql.replace(", explanation TEXT)", ")"))
+            c.execute(older(sql))
         c.execute("INSERT INTO runs (run, command, started_at) VALUES ('r1', 'rvc check', 1)")
         c.execute("INSERT INTO violations (run, property, time, wall, witness) VALUES ('r1', 'p1', 3, 4, '[]')")
     before = hashlib.sha256(db.read_bytes()).hexdigest()
@@ -588,6 +594,39 @@ def test_an_older_database_is_served_as_it_is(tmp_path):
     finally:
         assert d.stop() == 0
     assert hashlib.sha256(db.read_bytes()).hexdigest() == before
+
+
+def test_delayed_verdicts_keep_known_at_and_an_older_database_gains_the_column(tmp_path):
+    """Bounded future (issue 29): a delayed verdict is stored with the instant it became known
+    (known_at), a past-only one with known_at = time; a database from before known_at (no such
+    column) is migrated by the next run; the API returns known_at (null for an older database's rows,
+    which the dashboard reads without migrating). Hand-computed: p at step 2 only, eventually[1:2]{p}
+    is true for 0 (known at 2) and false from 2 (known at 4)."""
+    db = tmp_path / "old.db"
+    with sqlite3.connect(db) as c:
+        for sql in SCHEMA:
+            c.execute(sql.replace(", known_at DOUBLE PRECISION)", ")"))  # explanations, no known_at
+        c.execute("INSERT INTO runs (run, command, started_at) VALUES ('r0', 'rvc check', 1)")
+        c.execute("INSERT INTO verdicts (run, property, time, value, wall) VALUES ('r0', 'p1', 3, 1, 4)")
+    trace = tmp_path / "t.jsonl"
+    trace.write_text("".join(json.dumps({"p": p}) + "\n" for p in [False, False, True, False, False]))
+    r = subprocess.run([rvc_binary(), "check", "-s", "eventually[1:2]{p}", "-s", "historically{p: false}",
+                        "--output", f"sqlite:{db}", str(trace)], capture_output=True, text=True, timeout=30)
+    assert r.returncode == 1, r.stderr
+    with sqlite3.connect(db) as c:
+        rows = c.execute("SELECT property, time, value, known_at FROM verdicts WHERE run != 'r0' ORDER BY id").fetchall()
+        assert rows == [("p2", 0, 1, 0), ("p1", 0, 1, 2), ("p2", 2, 0, 2), ("p1", 2, 0, 4)]
+        assert c.execute("SELECT property, time, known_at FROM violations ORDER BY id").fetchall() == [
+            ("p2", 2, 2), ("p1", 2, 4)]
+    d = Dashboard(f"sqlite:{db}")
+    try:
+        run = [x["run"] for x in d.get("/api/runs")[1]["runs"] if x["run"] != "r0"][0]
+        verdicts = d.get(f"/api/runs/{run}/verdicts")[1]["verdicts"]
+        assert [(v["property"], v["time"], v["known_at"]) for v in verdicts] == [
+            ("p2", 0, 0), ("p1", 0, 2), ("p2", 2, 2), ("p1", 2, 4)]
+        assert [v["known_at"] for v in d.get("/api/runs/r0/verdicts")[1]["verdicts"]] == [None]
+    finally:
+        assert d.stop() == 0
 
 
 # --- the same API over PostgreSQL ------------------------------------------------------------------
