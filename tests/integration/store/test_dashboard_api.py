@@ -242,11 +242,11 @@ def test_verdicts_after_and_property(dash):
 
     status, body = dash.get("/api/runs/r-mid/verdicts")
     assert body == {"run": "r-mid", "after": 0, "last_id": 5, "more": False, "verdicts": [
-        {"id": 1, "property": "p1", "time": 0, "value": True, "wall": 2001},
-        {"id": 2, "property": "p2", "time": 0, "value": True, "wall": 2001},
-        {"id": 3, "property": "p1", "time": 3, "value": False, "wall": 2003},
-        {"id": 4, "property": "p2", "time": 5, "value": False, "wall": 2005},
-        {"id": 5, "property": "p1", "time": 7, "value": True, "wall": 2007}]}
+        {"id": 1, "property": "p1", "time": 0, "value": True, "wall": 2001, "known_at": None},
+        {"id": 2, "property": "p2", "time": 0, "value": True, "wall": 2001, "known_at": None},
+        {"id": 3, "property": "p1", "time": 3, "value": False, "wall": 2003, "known_at": None},
+        {"id": 4, "property": "p2", "time": 5, "value": False, "wall": 2005, "known_at": None},
+        {"id": 5, "property": "p1", "time": 7, "value": True, "wall": 2007, "known_at": None}]}
     assert ids("/api/runs/r-mid/verdicts?after=2") == ([3, 4, 5], 5, False)
     assert ids("/api/runs/r-mid/verdicts?property=p1") == ([1, 3, 5], 5, False)
     assert ids("/api/runs/r-mid/verdicts?after=3&property=p1") == ([5], 5, False)
@@ -276,9 +276,9 @@ def test_violations_with_parsed_witness(dash):
     status, body = dash.get("/api/runs/r-mid/violations")
     assert status == 200 and body["last_id"] == 3 and body["more"] is False
     assert body["violations"] == [
-        {"id": 1, "property": "p1", "time": 3, "wall": 2003, "witness": WITNESS, "explanation": None},
-        {"id": 2, "property": "p2", "time": 5, "wall": 2005, "witness": HEX_WITNESS, "explanation": None},
-        {"id": 3, "property": "p2", "time": 9, "wall": 2009, "witness": "not json [", "explanation": None},  # as text
+        {"id": 1, "property": "p1", "time": 3, "wall": 2003, "witness": WITNESS, "explanation": None, "known_at": None},
+        {"id": 2, "property": "p2", "time": 5, "wall": 2005, "witness": HEX_WITNESS, "explanation": None, "known_at": None},
+        {"id": 3, "property": "p2", "time": 9, "wall": 2009, "witness": "not json [", "explanation": None, "known_at": None},  # as text
     ]
     status, body = dash.get("/api/runs/r-mid/violations?after=1&property=p2&limit=1")
     assert [v["id"] for v in body["violations"]] == [2] and body["more"] is True
@@ -374,9 +374,10 @@ def test_events_deliver_rows_inserted_after_connecting(dash, db):
         assert e is not None, f"events so far: {got}"
         got[e[0]] = e
     # (ev.next's timeout bounds the wait: rows arrive live, not at the end of a long poll)
-    assert got["verdict"][1] == [{"id": vid, "property": "p9", "time": 4.5, "value": False, "wall": 3010}]
+    assert got["verdict"][1] == [{"id": vid, "property": "p9", "time": 4.5, "value": False, "wall": 3010,
+                                  "known_at": None}]
     assert got["violation"][1] == [{"id": kid, "property": "p9", "time": 4.5, "wall": 3010, "witness": WITNESS,
-                                    "explanation": None}]
+                                    "explanation": None, "known_at": None}]
     assert [(c["id"], c["counters"]) for c in got["counters"][1]] == [(cid, {"input": "a", "received": 500})]
     assert got["counters"][1][0]["rates"] == {"seconds": 4, "received_per_s": 50, "checked_per_s": None}
     assert got["counters"][2] == f"{vid},{kid},{cid}"  # the cursor, for a reconnecting EventSource
