@@ -173,3 +173,86 @@ def test_dense_boolean_matches_interval_oracle(rvc, tmp_path, seed):
             assert known == min(t + h, T) or (h == 0 and known == t), (text(f), t, known, h, T)
         # The first verdict is about 0.
         assert not changes or changes[0][0] == 0
+
+
+# ---- Robustness: the same formulas over numeric atoms, against a grid oracle ----------------------
+# Every breakpoint is a multiple of 0.25 (stamps and bounds), so each signal is constant on the cells
+# [k/4, (k+1)/4): the oracle computes one value per cell. once[a:b] at t takes the max over the
+# cells meeting [t-b, t-a] inside [0, T) (-inf when none), eventually over [t+a, t+b]; historically
+# and always the min (+inf when none); not negates, and/or/implies are min/max, as RTAMT and Reelay.
+STEP = 0.25
+ROBUST_ATOMS = {"{x > 2}": lambda e: e["x"] - 2, "{y < 1}": lambda e: 1 - e["y"]}
+
+
+def robust_cells(f, atoms, n):
+    op = f[0]
+    if op == "atom":
+        return atoms[f[1]]
+    if op == "not":
+        return [-v for v in robust_cells(f[1], atoms, n)]
+    if op in ("and", "or", "implies"):
+        a, b = robust_cells(f[1], atoms, n), robust_cells(f[2], atoms, n)
+        if op == "implies":
+            a = [-v for v in a]
+        return [min(x, y) if op == "and" else max(x, y) for x, y in zip(a, b)]
+    lo, hi, sub = int(f[1] / STEP), int(f[2] / STEP), robust_cells(f[3], atoms, n)
+    out = []
+    for k in range(n):
+        cells = range(k - hi, k - lo + 1) if op in ("once", "historically") else range(k + lo, k + hi + 1)
+        vals = [sub[c] for c in cells if 0 <= c < n]
+        if op in ("once", "eventually"):
+            out.append(max(vals) if vals else float("-inf"))
+        else:
+            out.append(min(vals) if vals else float("inf"))
+    return out
+
+
+def robust_formula(rng, depth):
+    f = formula(rng, depth, True)
+
+    def swap(g):
+        if g[0] == "atom":
+            return ("atom", rng.choice(list(ROBUST_ATOMS)))
+        if g[0] == "not":
+            return ("not", swap(g[1]))
+        if g[0] in ("and", "or", "implies"):
+            return (g[0], swap(g[1]), swap(g[2]))
+        return (g[0], g[1], g[2], swap(g[3]))
+    return swap(f)
+
+
+@pytest.mark.parametrize("seed", range(CASES))
+def test_dense_robustness_matches_grid_oracle(rvc, tmp_path, seed):
+    rng = random.Random(20_000 + seed)
+    formulas = [robust_formula(rng, rng.randint(1, 4)) for _ in range(FORMULAS_PER_CASE)]
+    events = trace(rng)
+    for e in events:
+        e["y"] = rng.choice([-1.5, 0.25, 0.5, 2, 3.25])
+    T = events[-1]["time"]
+    n = int(T / STEP)
+    atoms = {name: [] for name in ROBUST_ATOMS}
+    for k in range(n):
+        e = [e for e in events if e["time"] <= k * STEP][-1]
+        for name, margin in ROBUST_ATOMS.items():
+            atoms[name].append(float(margin(e)))
+    props = tmp_path / "props.json"
+    props.write_text(json.dumps({"properties": [{"name": f"f{i}", "spec": text(f)} for i, f in enumerate(formulas)]}))
+    tr = tmp_path / "trace.jsonl"
+    tr.write_text("".join(json.dumps(e) + "\n" for e in events))
+    proc = subprocess.run([rvc, "check", "--dense", "--robustness", "--clock", "off", "--properties", str(props),
+                           str(tr)], capture_output=True, text=True)
+    assert proc.returncode in (0, 1), proc.stderr
+    changes = {f"f{i}": [] for i in range(len(formulas))}
+    for line in proc.stdout.splitlines():
+        v = json.loads(line)
+        value = v["value"]
+        value = {"inf": float("inf"), "-inf": float("-inf")}.get(value, value) if isinstance(value, str) else value
+        changes[v["property"]].append((v["time"], float(value)))
+    for i, f in enumerate(formulas):
+        want = robust_cells(f, atoms, n)
+        cs = changes[f"f{i}"]
+        ours = []
+        for k in range(n):
+            at = [v for t, v in cs if t <= k * STEP]
+            ours.append(at[-1] if at else None)
+        assert ours == want, f"seed {seed}: {text(f)}\nrvc {cs}\noracle {want}\n{events}"
