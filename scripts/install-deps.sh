@@ -64,11 +64,10 @@ fi
 
 # Python test oracles and peers: Reelay (the reference monitors), the official
 # Zenoh binding, CycloneDDS's Python binding, rosbags (ROS 2 CDR and rosbag2 bags),
-# Foxglove's MCAP writer with its chunk compressions (zstd, lz4), RTAMT (the bounded-future
-# oracle, tests/differential/test_future_rtamt.py; it pins antlr4-python3-runtime 4.7), pytest.
+# Foxglove's MCAP writer with its chunk compressions (zstd, lz4), pytest.
 PY=${PYTHON:-python3}
 PIP_PACKAGES=(pytest "reelay==25.0.0" "eclipse-zenoh==1.10.2" "cyclonedds==11.0.1" "rosbags==0.11.9" matplotlib
-  "mcap==1.6.0" "zstandard==0.25.0" "lz4==4.4.5" "rtamt==0.4.10")
+  "mcap==1.6.0" "zstandard==0.25.0" "lz4==4.4.5")
 if ! "$PY" - "${PIP_PACKAGES[@]}" <<'PYEOF' 2>/dev/null
 import sys
 from importlib.metadata import version, PackageNotFoundError

@@ -23,11 +23,4 @@ void append_robustness(std::string& out, double time, bool /*discrete*/, std::st
   out += "}\n";
 }
 
-void append_known_at(std::string& out, double known_at) {
-  out.resize(out.size() - 2);  // "}\n"
-  out += ",\"known_at\":";
-  append_number(out, known_at);
-  out += "}\n";
-}
-
 }  // namespace rvc::io

@@ -19,6 +19,11 @@ void append_robustness(std::string& out, double time, bool discrete, std::string
 // became known, to the verdict line just appended:
 // {"time":3,"property":"p1","value":false,"known_at":5}. Past-only
 // properties' lines have no such field (known at "time").
-void append_known_at(std::string& out, double known_at);
+inline void append_known_at(std::string& out, double known_at) {
+  out.resize(out.size() - 2);  // "}\n"
+  out += ",\"known_at\":";
+  append_number(out, known_at);
+  out += "}\n";
+}
 
 }  // namespace rvc::io

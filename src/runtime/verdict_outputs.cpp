@@ -1,6 +1,5 @@
 #include "runtime/verdict_outputs.hpp"
 
-#include <cmath>
 #include <stdexcept>
 
 #include "io/cdr_codec.hpp"
@@ -14,7 +13,6 @@ void VerdictOutputs::put(const engine::Verdict& v) {
   line_.clear();
   if (v.robust) io::append_robustness(line_, v.time, discrete_, v.property, v.robustness);
   else io::append_verdict(line_, v.time, discrete_, v.property, v.value);
-  if (!std::isnan(v.known_at) && !type_) io::append_known_at(line_, v.known_at);
   if (v.explanation && !type_) {  // {"time":..,"value":false,"explain":["...", ...]} (typed verdicts have no field for it)
     line_.resize(line_.size() - 2);  // "}\n"
     line_ += ",\"explain\":[";
@@ -24,6 +22,7 @@ void VerdictOutputs::put(const engine::Verdict& v) {
     }
     line_ += "]}\n";
   }
+  if (v.known_at == v.known_at && !type_) io::append_known_at(line_, v.known_at);  // bounded future: not NaN
   line_.pop_back();  // one message per verdict: no newline (file sinks add their own)
   put_payload(line_);
 }
