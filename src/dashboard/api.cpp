@@ -229,13 +229,16 @@ Response run_detail(Database& db, const std::string& run, const Params& params) 
 
 // --- rows that follow a table by id -----------------------------------------
 
-io::JsonObject verdict_object(const Row& v) {  // id, property, time, value, wall
+// known_at (bounded future, issue 29): the instant a verdict became known;
+// null in a database of an older rvc, where every verdict is known at its time.
+io::JsonObject verdict_object(const Row& v) {  // id, property, time, value, wall, known_at
   return io::JsonObject()
       .add_raw("id", json_number(v[0]))
       .add("property", v[1])
       .add_raw("time", json_number(v[2]))
       .add_raw("value", json_bool_or_null(v[3]))
-      .add_raw("wall", json_wall(v[4]));
+      .add_raw("wall", json_wall(v[4]))
+      .add_raw("known_at", json_number(v[5]));
 }
 
 io::JsonObject violation_object(const Row& v) {  // id, property, time, wall, witness, explanation
@@ -245,7 +248,8 @@ io::JsonObject violation_object(const Row& v) {  // id, property, time, wall, wi
       .add_raw("time", json_number(v[2]))
       .add_raw("wall", json_wall(v[3]))
       .add_raw("witness", embedded_json(v[4]))
-      .add_raw("explanation", embedded_json(v[5]));  // null without --explain
+      .add_raw("explanation", embedded_json(v[5]))  // null without --explain
+      .add_raw("known_at", json_number(v[6]));
 }
 
 // Rows of `table` after id `after` (in id order), at most `limit`.
@@ -262,8 +266,8 @@ QueryResult rows_after(Database& db, const char* columns, const char* table, con
   return db.query(sql, args);
 }
 
-const char* const kVerdictColumns = "id, property, time, value, wall";
-const char* const kViolationColumns = "id, property, time, wall, witness, explanation";
+const char* const kVerdictColumns = "id, property, time, value, wall, known_at";
+const char* const kViolationColumns = "id, property, time, wall, witness, explanation, known_at";
 
 // A database written by an rvc before explanations were stored has no such
 // column, and the dashboard reads databases as they are (it never migrates
@@ -271,10 +275,27 @@ const char* const kViolationColumns = "id, property, time, wall, witness, explan
 const char* violation_columns(Database& db) {
   try {
     db.query("SELECT explanation FROM violations LIMIT 0");
+  } catch (const store::DbError& e) {
+    if (e.connection_lost()) throw;
+    return "id, property, time, wall, witness, NULL AS explanation, NULL AS known_at";
+  }
+  try {
+    db.query("SELECT known_at FROM violations LIMIT 0");
     return kViolationColumns;
   } catch (const store::DbError& e) {
     if (e.connection_lost()) throw;
-    return "id, property, time, wall, witness, NULL AS explanation";
+    return "id, property, time, wall, witness, explanation, NULL AS known_at";
+  }
+}
+
+// The same for verdicts: known_at (bounded future) came later.
+const char* verdict_columns(Database& db) {
+  try {
+    db.query("SELECT known_at FROM verdicts LIMIT 0");
+    return kVerdictColumns;
+  } catch (const store::DbError& e) {
+    if (e.connection_lost()) throw;
+    return "id, property, time, value, wall, NULL AS known_at";
   }
 }
 const char* const kCounterColumns = "id, wall, counters";
@@ -466,7 +487,7 @@ Response handle_api(Database& db, const std::string& path, const Params& params)
       // run id may itself hold slashes.
       const std::string rest = path.substr(prefix.size());
       if (ends_with(rest, "/verdicts"))
-        return follow(db, rest.substr(0, rest.size() - 9), params, kVerdictColumns, "verdicts", "verdicts",
+        return follow(db, rest.substr(0, rest.size() - 9), params, verdict_columns(db), "verdicts", "verdicts",
                       kVerdictsDefault, kVerdictsMax, verdict_object);
       if (ends_with(rest, "/violations"))
         return follow(db, rest.substr(0, rest.size() - 11), params, violation_columns(db), "violations", "violations",
@@ -533,7 +554,7 @@ std::string poll_events(Database& db, EventCursor& cursor) {
     emit(event, to_array(rows));
   };
   if (!cursor.run.empty()) {
-    follow_table("verdict", kVerdictColumns, "verdicts", cursor.verdict, 2000, [](const QueryResult& rows) {
+    follow_table("verdict", verdict_columns(db), "verdicts", cursor.verdict, 2000, [](const QueryResult& rows) {
       io::JsonArray a;
       for (const Row& r : rows) a.add(verdict_object(r));
       return a.str();

@@ -1,11 +1,13 @@
 #include "engine/checker.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <limits>
 #include <stdexcept>
 
 #include "spec/parser.hpp"
+#include "spec/pastify.hpp"
 #include "spec/spec_error.hpp"
 
 namespace rvc::engine {
@@ -33,6 +35,8 @@ void Checker::add_property(const PropertySpec& property) {
   options.dense = model_ == TimeModel::Dense;
   options.robustness = robustness_;
   spec::NodePtr ast = spec::parse(property.spec, options);
+  const double h = spec::horizon(*ast);
+  if (spec::has_future(*ast)) ast = pastified(*ast, h, property.spec);  // h may be 0: until[0:0]
   Program program = compile(*ast, atoms_, model_, property.spec);
   if (program.has_data()) {
     if (robustness_)
@@ -47,15 +51,13 @@ void Checker::add_property(const PropertySpec& property) {
       if (explain_) data_.back().enable_explain();
       where_.emplace_back(kData, static_cast<uint32_t>(data_.size() - 1));
     }
-    names_.push_back(property.name);
-    last_.push_back(-1);
+    add_name(property.name, h);
     return;
   }
   if (robustness_ && model_ == TimeModel::Dense) {
     robust_dense_.emplace_back(program);
     last_robustness_.push_back(std::numeric_limits<double>::quiet_NaN());
-    names_.push_back(property.name);
-    last_.push_back(-1);
+    add_name(property.name, h);
     return;
   }
   if (robustness_) {
@@ -77,15 +79,149 @@ void Checker::add_property(const PropertySpec& property) {
   } catch (const std::length_error& e) {  // the monitor's size limit: a spec problem, not a runtime failure
     throw spec::SpecError(std::string(e.what()) + "; split it into several properties", property.spec, 1);
   }
-  names_.push_back(property.name);
+  add_name(property.name, h);
+}
+
+namespace {
+bool has_quantifier(const spec::Node& n) {
+  if (n.op == spec::Op::Exists || n.op == spec::Op::Forall) return true;
+  return (n.left && has_quantifier(*n.left)) || (n.right && has_quantifier(*n.right));
+}
+// The end-of-stream marker's field: no message has it (a control character
+// starts it), so it is false until finish() sets it (spec/pastify.hpp).
+constexpr const char* kEndMarkerField = "\x01rvc-end-of-stream";
+}  // namespace
+
+spec::NodePtr Checker::pastified(const spec::Node& ast, double h, const std::string& source) {
+  if (explain_) throw spec::SpecError("--explain does not explain bounded-future properties yet", source, 1);
+  if (has_quantifier(ast))
+    throw spec::SpecError("bounded future (eventually, always, until, next) with exists/forall is not supported yet",
+                          source, 1);
+  // The end of a discrete stream settles a verdict per step of the horizon
+  // (finish): bounded so that ending a run never takes minutes.
+  constexpr double kMaxDiscreteHorizon = 1e7;
+  if (model_ == TimeModel::Discrete && h > kMaxDiscreteHorizon)
+    throw spec::SpecError("the future horizon is " + std::to_string(static_cast<uint64_t>(h)) +
+                              " steps; discrete time allows up to 10000000 (the verdicts of the last horizon are "
+                              "settled one step each at the end of the stream)",
+                          source, 1);
+  if (end_atom_ < 0) {
+    spec::FieldTest end;
+    end.path = {kEndMarkerField};
+    end_atom_ = atoms_.intern(end);
+  }
+  return spec::pastify(ast, h, atoms_.tests()[static_cast<size_t>(end_atom_)], model_ == TimeModel::Dense, source);
+}
+
+void Checker::add_name(const std::string& name, double delay) {
+  names_.push_back(name);
   last_.push_back(-1);
+  delay_.push_back(delay);
+  stash_.push_back(std::numeric_limits<double>::quiet_NaN());
+  if (delay > 0) {
+    delayed_.push_back(static_cast<uint32_t>(names_.size() - 1));
+    if (delay > max_delay_) max_delay_ = delay;
+  }
+}
+
+bool Checker::refer(size_t i, double& time, double& known, double value) {
+  const double d = delay_[i];
+  known = std::numeric_limits<double>::quiet_NaN();
+  if (d > 0) {
+    if (time < d) {  // about an instant before the start: dense time keeps it for the start
+      if (model_ == TimeModel::Dense) stash_[i] = value;
+      return false;
+    }
+    if (time > d && !std::isnan(stash_[i])) {  // the start's value held until this change
+      const double v = stash_[i];
+      stash_[i] = std::numeric_limits<double>::quiet_NaN();
+      const double at = finished_ ? std::min(d, end_known_) : d;
+      if (robustness_) emit_robust(i, 0, v, at);
+      else emit(i, 0, v != 0, at, nullptr);
+    }
+    stash_[i] = std::numeric_limits<double>::quiet_NaN();
+    known = finished_ ? std::min(time, end_known_) : time;  // settled: known when the stream ended
+    time -= d;
+    // Dense time: 1.2 - 1 is 0.19999999999999996; stamps are written with
+    // at most nanoseconds, so a difference within rounding error of a whole
+    // nanosecond is that nanosecond.
+    if (model_ == TimeModel::Dense) {
+      const double ns = std::round(time * 1e9) / 1e9;
+      if (std::abs(ns - time) <= 1e-12 * std::max(1.0, std::abs(time))) time = ns;
+    }
+  }
+  return time < end_;
+}
+
+// Dense time: a start value no change followed, once the clock passed it.
+void Checker::flush_stash() {
+  for (uint32_t i : delayed_) {
+    if (std::isnan(stash_[i]) || !(clock_ > delay_[i])) continue;
+    const double v = stash_[i];
+    stash_[i] = std::numeric_limits<double>::quiet_NaN();
+    if (0 >= end_) continue;
+    const double at = finished_ ? std::min(delay_[i], end_known_) : delay_[i];
+    if (robustness_) emit_robust(i, 0, v, at);
+    else emit(i, 0, v != 0, at, nullptr);
+  }
+}
+
+void Checker::finish() {
+  if (finished_ || delayed_.empty()) return;
+  finished_ = true;
+  const auto end = static_cast<size_t>(end_atom_);
+  if (model_ == TimeModel::Discrete) {
+    if (last_atoms_.empty() && last_margins_.empty()) return;  // no step: nothing pending
+    end_ = static_cast<double>(robustness_ ? now_robust_ : now_discrete_);
+    end_known_ = end_ - 1;
+    const auto steps = static_cast<int64_t>(max_delay_);
+    if (robustness_) {
+      std::vector<double> margins = last_margins_;
+      margins[end] = std::numeric_limits<double>::infinity();
+      for (int64_t k = 0; k < steps; ++k) step_robust(margins.data());
+    } else {
+      std::vector<uint8_t> atoms = last_atoms_;
+      atoms[end] = 1;
+      for (int64_t k = 0; k < steps; ++k) step(atoms.data());
+    }
+    return;
+  }
+  // Dense time: the stream covers [0, clock). A tick at the clock (the end
+  // tick of a recording) told the value at that instant too: it stays part
+  // of the stream, and the windows are cut just after it, 1e-9 (relative)
+  // later: a gap that bounds added to it do not round away.
+  const double cut = told_at_ == clock_ ? clock_ + 1e-9 * std::max(1.0, std::abs(clock_)) : clock_;
+  end_ = cut;
+  end_known_ = clock_;
+  // Up to and with clock + delay (cut + delay may round down to it).
+  const double until = std::nextafter(cut + max_delay_, std::numeric_limits<double>::infinity());
+  if (robustness_) {
+    if (last_margins_.empty()) last_margins_.assign(atoms_.size(), -std::numeric_limits<double>::infinity());
+    std::vector<double> margins = last_margins_;
+    if (cut > clock_) step_robust(clock_, cut, margins.data());
+    margins[end] = std::numeric_limits<double>::infinity();
+    step_robust(cut, until, margins.data());
+  } else {
+    if (last_atoms_.empty()) last_atoms_.assign(atoms_.size(), 0);
+    std::vector<uint8_t> atoms = last_atoms_;
+    if (cut > clock_) step(clock_, cut, atoms.data());
+    atoms[end] = 1;
+    step(cut, until, atoms.data());
+  }
 }
 
 void Checker::report(size_t property, double time, bool value, const std::vector<std::string>* explanation) {
+  double known;
+  if (!refer(property, time, known, value ? 1 : 0)) return;
+  emit(property, time, value, known, explanation);
+}
+
+void Checker::emit(size_t property, double time, bool value, double known,
+                   const std::vector<std::string>* explanation) {
   if (!emit_all_ && last_[property] == static_cast<int8_t>(value)) return;
   last_[property] = static_cast<int8_t>(value);
   if (!value) ++violations_;
-  if (on_verdict_) on_verdict_(Verdict{names_[property], time, value, false, 0, explanation});
+  if (on_verdict_) on_verdict_(Verdict{names_[property], time, value, false, 0, explanation, known});
 }
 
 void Checker::report_discrete(size_t i, double now) {
@@ -151,6 +287,9 @@ void Checker::step_changes(const uint8_t* atoms) {
     for (size_t i = 0; i < where_.size(); ++i) report_discrete(i, now);
     return;
   }
+  // A delayed property's first verdict comes at its delay, changed or not.
+  for (uint32_t i : delayed_)
+    if (delay_[i] == now) changed_properties_.push_back(i);
   // Properties in their order, as the plain loop reports them.
   std::sort(changed_properties_.begin(), changed_properties_.end());
   for (uint32_t i : changed_properties_) report_discrete(i, now);
@@ -158,6 +297,7 @@ void Checker::step_changes(const uint8_t* atoms) {
 
 void Checker::step(const uint8_t* atoms, const uint32_t* bound) {
   if (where_.empty()) return;
+  if (!delayed_.empty() && !finished_) last_atoms_.assign(atoms, atoms + atoms_.size());
   if (incremental_ && data_.empty()) {
     step_changes(atoms);
     return;
@@ -182,37 +322,49 @@ void Checker::step(const uint8_t* atoms, const uint32_t* bound) {
 
 void Checker::step_robust(const double* margins) {
   const double now = static_cast<double>(now_robust_++);
+  if (!delayed_.empty() && !finished_) last_margins_.assign(margins, margins + atoms_.size());
   for (size_t i = 0; i < robust_.size(); ++i) {
     const double r = robust_[i].step(margins);
+    double time = now, known;
+    if (!refer(i, time, known, r)) continue;
     // Condensed as Reelay condenses: a value equal to the last one is no change.
     if (!emit_all_ && r == last_robustness_[i]) continue;
     last_robustness_[i] = r;
     const bool holds = r > 0;  // 0 is not a margin: a false Boolean field is 0
     if (!holds) ++violations_;
-    if (on_verdict_) on_verdict_(Verdict{names_[i], now, holds, true, r});
+    if (on_verdict_) on_verdict_(Verdict{names_[i], time, holds, true, r, nullptr, known});
   }
 }
 
 void Checker::report_robust(size_t i, double time, double r) {
+  double known;
+  if (!refer(i, time, known, r)) return;
+  emit_robust(i, time, r, known);
+}
+
+void Checker::emit_robust(size_t i, double time, double r, double known) {
   if (r == last_robustness_[i]) return;  // changes only, as for Booleans in dense time (emit_all too)
   last_robustness_[i] = r;
   const bool holds = r > 0;
   if (!holds) ++violations_;
-  if (on_verdict_) on_verdict_(Verdict{names_[i], time, holds, true, r});
+  if (on_verdict_) on_verdict_(Verdict{names_[i], time, holds, true, r, nullptr, known});
 }
 
 void Checker::step_robust(double begin, double end, const double* margins) {
   if (begin < clock_) begin = clock_;  // a tick went there already
   if (!(begin < end)) return;
   clock_ = end;
+  if (!delayed_.empty() && !finished_) last_margins_.assign(margins, margins + atoms_.size());
   for (size_t i = 0; i < robust_dense_.size(); ++i)
     for (const robust::RealPiece& p : robust_dense_[i].step(begin, end, margins).pieces) report_robust(i, p.t, p.v);
+  if (!delayed_.empty()) flush_stash();
 }
 
 void Checker::step(double begin, double end, const uint8_t* atoms, const uint32_t* bound) {
   if (begin < clock_) begin = clock_;  // a tick went there already
   if (!(begin < end)) return;  // an empty segment has no value to report
   clock_ = end;
+  if (!delayed_.empty() && !finished_) last_atoms_.assign(atoms, atoms + atoms_.size());
   const bool told = emit_all_ && begin == told_at_;  // a tick at begin reported its value: not twice
   for (size_t i = 0; i < where_.size(); ++i) {
     const auto [kind, k] = where_[i];
@@ -229,6 +381,7 @@ void Checker::step(double begin, double end, const uint8_t* atoms, const uint32_
       }
     }
   }
+  if (!delayed_.empty()) flush_stash();
 }
 
 bool Checker::value_at_clock(size_t i, const uint8_t* atoms, const uint32_t* bound) {
@@ -239,6 +392,7 @@ bool Checker::value_at_clock(size_t i, const uint8_t* atoms, const uint32_t* bou
 void Checker::tick(double now, const uint8_t* atoms, const uint32_t* bound) {
   if (model_ != TimeModel::Dense || !(now >= clock_)) return;  // behind the clock (or NaN): nothing to do
   if (now > clock_) step(clock_, now, atoms, bound);
+  if (!delayed_.empty() && !finished_) last_atoms_.assign(atoms, atoms + atoms_.size());
   clock_ = now;
   for (size_t i = 0; i < where_.size(); ++i) {
     const bool v = value_at_clock(i, atoms, bound);
@@ -257,6 +411,7 @@ void Checker::tick(double now, const uint8_t* atoms, const uint32_t* bound) {
 void Checker::tick_robust(double now, const double* margins) {
   if (model_ != TimeModel::Dense || !(now >= clock_)) return;
   if (now > clock_) step_robust(clock_, now, margins);
+  if (!delayed_.empty() && !finished_) last_margins_.assign(margins, margins + atoms_.size());
   clock_ = now;
   for (size_t i = 0; i < robust_dense_.size(); ++i) report_robust(i, now, robust_dense_[i].at(now, margins));
   told_at_ = now;
@@ -267,8 +422,11 @@ double Checker::next_deadline(const uint8_t* atoms, const uint32_t* bound) {
   if (model_ != TimeModel::Dense) return kNever;  // discrete time has no clock: steps are messages
   double next = kNever;
   for (size_t i = 0; i < where_.size(); ++i) {
-    const bool v = value_at_clock(i, atoms, bound);
-    if (emit_all_ ? told_at_ != clock_ : last_[i] != static_cast<int8_t>(v)) return clock_;  // not told yet
+    const bool v = value_at_clock(i, atoms, bound);  // first: next_change reads what it computed
+    // A delayed property's value before its delay is about no instant of the
+    // stream: its first verdict (for 0) is due at the delay.
+    if (clock_ < delay_[i]) next = std::min(next, delay_[i]);
+    else if (emit_all_ ? told_at_ != clock_ : last_[i] != static_cast<int8_t>(v)) return clock_;  // not told yet
     const auto [kind, k] = where_[i];
     const double t = kind == kData ? dense_data_[k].next_change(clock_) : dense_[k].next_change(clock_);
     if (t < next) next = t;
@@ -282,7 +440,8 @@ double Checker::next_deadline_robust(const double* margins) {
   double next = kNever;
   for (size_t i = 0; i < robust_dense_.size(); ++i) {
     const double r = robust_dense_[i].at(clock_, margins);
-    if (!(r == last_robustness_[i])) return clock_;  // not told yet
+    if (clock_ < delay_[i]) next = std::min(next, delay_[i]);  // as in next_deadline
+    else if (!(r == last_robustness_[i])) return clock_;  // not told yet
     const double t = robust_dense_[i].next_change(clock_);
     if (t < next) next = t;
   }

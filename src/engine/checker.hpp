@@ -32,6 +32,11 @@ struct Verdict {
   double robustness = 0;
   // --explain, at the start of a violation: why (Monitor::explain); else null.
   const std::vector<std::string>* explanation = nullptr;
+  // Bounded future (issue 29): `time` is the instant the verdict is about and
+  // known_at the instant it became known (time + the property's horizon;
+  // docs/semantics.md, "Bounded future"). NaN for past-only properties,
+  // whose verdicts are known at their own time.
+  double known_at = std::numeric_limits<double>::quiet_NaN();
 };
 using VerdictCallback = std::function<void(const Verdict&)>;
 
@@ -120,8 +125,33 @@ class Checker {
 
   uint64_t violations() const { return violations_; }  // verdicts reported false
 
+  // ---- Bounded future (issue 29; docs/semantics.md, "Bounded future") ----
+  // A property with future operators is checked with a delay equal to its
+  // horizon (spec/pastify.hpp): its verdict for t is reported when the
+  // stream reaches t + horizon, with known_at set. 0 for past-only ones.
+  double delay(size_t property) const { return delay_[property]; }
+  double max_delay() const { return max_delay_; }
+  // End of stream: settles the verdicts still pending (the last `horizon`
+  // time units of each delayed property), with every future operator's
+  // window cut at the end: eventually/until need a witness inside the
+  // stream, always only the steps it has. Reports nothing past the end
+  // (discrete: the last step; dense: the clock). Call once, after the last
+  // step or tick; nothing to do without delayed properties.
+  void finish();
+
  private:
   void report(size_t property, double time, bool value, const std::vector<std::string>* explanation = nullptr);
+  // A delayed property's verdict at monitor time `time`: false when it is not
+  // reported (it refers to before the start, or past the end while
+  // settling); else `time` becomes the instant referred to and `known` the
+  // instant it became known. Dense time keeps the last value before the
+  // delay (`stash`) for the start, told when the first later change comes.
+  bool refer(size_t property, double& time, double& known, double value);
+  void emit(size_t property, double time, bool value, double known, const std::vector<std::string>* explanation);
+  void emit_robust(size_t property, double time, double r, double known);
+  void flush_stash();
+  spec::NodePtr pastified(const spec::Node& ast, double horizon, const std::string& source);
+  void add_name(const std::string& name, double delay);
   void report_robust(size_t property, double time, double robustness);
   // Each property's value at the clock, the held values (tick, next_deadline).
   bool value_at_clock(size_t property, const uint8_t* atoms, const uint32_t* bound);
@@ -166,6 +196,19 @@ class Checker {
   std::vector<uint32_t> changed_atoms_, changed_roots_, changed_properties_;
   std::vector<std::vector<uint32_t>> property_of_;
   uint64_t violations_ = 0;
+  // Bounded future: per property its delay, and in dense time the value
+  // waiting for the start (NaN: none); the atoms/margins of the last step
+  // (kept only with a delayed property) for finish(); end_: no verdict
+  // from there on (+inf until finish()).
+  std::vector<double> delay_, stash_;
+  std::vector<uint32_t> delayed_;  // properties with a delay
+  double max_delay_ = 0;
+  int end_atom_ = -1;
+  double end_ = std::numeric_limits<double>::infinity();
+  double end_known_ = std::numeric_limits<double>::infinity();  // finish(): the stream's last instant
+  std::vector<uint8_t> last_atoms_;
+  std::vector<double> last_margins_;
+  bool finished_ = false;
 };
 
 }  // namespace rvc::engine

@@ -50,6 +50,12 @@ struct Compiler {
       case Op::Or: in.code = Code::Or; break;
       case Op::Implies: in.code = Code::Implies; break;
       case Op::Since: in.code = Code::Since; break;
+      case Op::Eventually:
+      case Op::Always:
+      case Op::Until:
+      case Op::Next:  // spec/pastify.hpp rewrites them first (engine::Checker)
+        fail(std::string("'") + spec::op_name(n.op) + "' reached the compiler without its rewrite into past operators",
+             n.column);
     }
     in.a = visit(*n.left);
     if (n.right) in.b = visit(*n.right);

@@ -14,6 +14,7 @@ Outcome run_check(Feed& feed, VerdictOutputs& outputs, const std::function<void(
   try {
     read(outcome);
     feed.end_of_input();
+    feed.settle();  // bounded future: the verdicts the stream's end decides
     outputs.finish();
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rvc: error: %s\n", e.what());

@@ -63,6 +63,9 @@ class Feed {
   virtual void idle() {}
   // Every input has ended (end-of-stream, file end): nothing more will come.
   virtual void end_of_input() {}
+  // The run ends (after end_of_input and the end's tick): bounded-future
+  // verdicts still pending are settled (engine::Checker::finish).
+  virtual void settle() {}
   // Several file inputs: the feed chooses which input's next message it
   // needs (a merge by stamp), and the caller reads that one. next_input()
   // returns it, or -1 once every input has ended and all is fed.

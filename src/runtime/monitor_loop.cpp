@@ -491,6 +491,7 @@ Outcome MonitorLoop::run(const std::vector<transport::Source*>& sources) {
     feed_.end_of_input();  // also after a signal or idle timeout: what is held is checked
     // A file's end: its last message's own verdicts (a tick at its stamp).
     if (options_.tick_at_end && end_ == EndReason::EndOfStream) feed_.tick(feed_.last_stamp());
+    feed_.settle();  // bounded future: the verdicts the stream's end decides
     outputs_.finish();
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rvc: error: %s\n", e.what());

@@ -127,6 +127,7 @@ class Pipeline final : public io::JsonlHandler, public Feed {
   // last accepted message's, fields it lacked kept from before).
   double next_deadline() override;
   void tick(double stream_now) override;
+  void settle() override { checker_.finish(); }
   double last_stamp() const override {
     return has_time_ ? last_time_ : std::numeric_limits<double>::quiet_NaN();
   }

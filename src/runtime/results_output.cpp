@@ -15,7 +15,8 @@ void ResultsOutput::attach(const std::string& input_name, PipelineOptions& optio
   options.on_message = [store](std::string_view input, std::string_view text, uint64_t position) {
     store->on_message(input, text, position);
   };
-  outputs.observe([store](const engine::Verdict& v) { store->on_verdict(v.property, v.time, v.value, v.explanation); });
+  outputs.observe([store](const engine::Verdict& v) { store->on_verdict(v.property, v.time, v.value, v.explanation, v.known_at);
+  });
 }
 
 void ResultsOutput::finish(Outcome& outcome, const std::string& reason, const std::string& final_counters) {

@@ -45,6 +45,7 @@ class ServiceCallFeed final : public Feed {
   void warn(const io::LineError& warning) override { inner_.warn(warning); }
   double next_deadline() override;
   void tick(double stream_now) override;
+  void settle() override { inner_.settle(); }
   double last_stamp() const override;
   void end_of_input() override;
   uint64_t received() const override { return calls_.counts().events; }

@@ -91,6 +91,7 @@ class SyncedPipeline final : public Feed, private sync::Handler {
   // (combined_), as the next set's step will be given them.
   double next_deadline() override;
   void tick(double stream_now) override;
+  void settle() override { checker_.finish(); }
   double last_stamp() const override {
     return has_time_ ? last_time_ : std::numeric_limits<double>::quiet_NaN();
   }

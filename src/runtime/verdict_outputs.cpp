@@ -55,6 +55,7 @@ void VerdictOutputs::put(const engine::Verdict& v) {
     }
     line_ += "]}\n";
   }
+  if (v.known_at == v.known_at && !type_) io::append_known_at(line_, v.known_at);  // bounded future: not NaN
   if (!mark_.empty() && !type_) line_.insert(line_.size() - 2, mark_);  // before "}\n"
   line_.pop_back();  // one message per verdict: no newline (file sinks add their own)
   if (verdict_type) sample_ = cdr_;

@@ -199,6 +199,10 @@ const char* op_name(Op op) {
     case Op::Since: return "since";
     case Op::Exists: return "exists";
     case Op::Forall: return "forall";
+    case Op::Eventually: return "eventually";
+    case Op::Always: return "always";
+    case Op::Until: return "until";
+    case Op::Next: return "next";
   }
   return "?";
 }
@@ -212,13 +216,17 @@ std::string to_string(const Node& n) {
     case Op::Pre:
     case Op::Once:
     case Op::Historically:
+    case Op::Next:
+    case Op::Eventually:
+    case Op::Always:
       return "(" + std::string(op_name(n.op)) + bounds_text(n.bounds) + " " + to_string(*n.left) + ")";
     case Op::And:
     case Op::Or:
     case Op::Implies:
       return "(" + to_string(*n.left) + " " + op_name(n.op) + " " + to_string(*n.right) + ")";
     case Op::Since:
-      return "(" + to_string(*n.left) + " since" + bounds_text(n.bounds) + " " + to_string(*n.right) + ")";
+    case Op::Until:
+      return "(" + to_string(*n.left) + " " + op_name(n.op) + bounds_text(n.bounds) + " " + to_string(*n.right) + ")";
     case Op::Exists:
     case Op::Forall: {
       std::string vars;

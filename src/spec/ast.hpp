@@ -105,17 +105,21 @@ enum class Op {
   Not, Pre, Once, Historically,  // unary
   And, Or, Implies, Since,       // binary
   Exists, Forall,                // data quantifiers (parsed; not yet evaluated)
+  // Bounded future (issue 29): rewritten into past operators with a delay
+  // (spec/pastify.hpp) before compiling; never reach an engine directly.
+  Eventually, Always, Until, Next,
 };
 
 struct Node {
   Op op;
   int column = 0;  // 1-based column of the operator in the spec text
-  Bounds bounds;   // Pre, Once, Historically, Since
+  Bounds bounds;   // Pre, Once, Historically, Since, Eventually, Always, Until
   FieldTest test;  // Test
   std::vector<std::string> variables;  // Exists, Forall
   std::unique_ptr<Node> left, right;   // unary operators use left only
 
   bool is_temporal() const { return op == Op::Pre || op == Op::Once || op == Op::Historically || op == Op::Since; }
+  bool is_future() const { return op == Op::Eventually || op == Op::Always || op == Op::Until || op == Op::Next; }
 };
 
 using NodePtr = std::unique_ptr<Node>;

@@ -49,8 +49,7 @@ class Parser {
     check_height(*node);
     if (!at_end()) {
       if (peek() == ')') fail("unmatched ')'", pos_);
-      if (peek_word("since") || peek_word("S"))
-        fail("chained 'since' is ambiguous: add parentheses, e.g. (a since b) since c", pos_);
+      refuse_chain();
       fail("unexpected '" + std::string(1, peek()) + "' after a complete formula (missing operator?)", pos_);
     }
     return node;
@@ -240,9 +239,12 @@ class Parser {
     NodePtr left = parse_unary();
     skip_ws();
     size_t at = pos_;
-    if (!(accept_word("since") || accept_word("S"))) return left;
-    auto node = make(Op::Since, at);
+    Op op = Op::Since;
+    if (accept_word("until")) op = Op::Until;
+    else if (!(accept_word("since") || accept_word("S"))) return left;
+    auto node = make(op, at);
     node->bounds = parse_bounds_opt(at);
+    if (op == Op::Until) check_future_bounds(node->bounds, "until", at);
     node->left = std::move(left);
     node->right = parse_unary();
     return node;
@@ -257,12 +259,20 @@ class Parser {
     else if (accept_word("pre") || accept_word("Y")) op = Op::Pre;
     else if (accept_word("once") || accept_word("P")) op = Op::Once;
     else if (accept_word("historically") || accept_word("H")) op = Op::Historically;
+    else if (accept_word("eventually")) op = Op::Eventually;
+    else if (accept_word("always")) op = Op::Always;
+    else if (accept_word("next")) op = Op::Next;
     else return parse_primary();
     Nest nest(*this, at);
     auto node = make(op, at);
     if (op != Op::Not) node->bounds = parse_bounds_opt(at);
     if (op == Op::Pre && node->bounds.explicit_bounds)
       fail("'pre' takes no time bounds: it always looks exactly one step back", at);
+    if (op == Op::Next && node->bounds.explicit_bounds)
+      fail("'next' takes no time bounds: it always looks exactly one step ahead (use eventually[a:b])", at);
+    if (op == Op::Next && opt_.dense)
+      fail("'next' has no meaning in dense time (there is no next step); use eventually[a:b] or discrete time", at);
+    if (op == Op::Eventually || op == Op::Always) check_future_bounds(node->bounds, op_name(op), at);
     node->left = parse_unary();
     return node;
   }
@@ -330,8 +340,7 @@ class Parser {
       NodePtr inner = parse_quantified();
       skip_ws();
       if (peek() != ')') {
-        if (peek_word("since") || peek_word("S"))
-          fail("chained 'since' is ambiguous: add parentheses, e.g. (a since b) since c", pos_);
+        refuse_chain();
         fail(at_end() ? "missing ')' to close the '(' at column " + column_text(at)
                       : "expected ')' to close the '(' at column " + column_text(at),
              pos_);
@@ -347,11 +356,30 @@ class Parser {
       size_t end = pos_;
       while (end < s_.size() && is_ident_char(s_[end])) ++end;
       std::string word = s_.substr(pos_, end - pos_);
-      if (word == "and" || word == "or" || word == "implies" || word == "since" || word == "S")
+      if (word == "and" || word == "or" || word == "implies" || word == "since" || word == "S" || word == "until")
         fail("'" + word + "' needs a formula on its left", pos_);
       fail("unknown word '" + word + "': atoms are written in braces, e.g. {" + word + "}", pos_);
     }
     fail("unexpected '" + std::string(1, c) + "': expected a formula", pos_);
+  }
+
+  // After a complete since/until: another one needs parentheses (Reelay
+  // silently drops the last part of `a since b since c`).
+  void refuse_chain() const {
+    if (peek_word("since") || peek_word("S"))
+      fail("chained 'since' is ambiguous: add parentheses, e.g. (a since b) since c", pos_);
+    if (peek_word("until"))
+      fail("chained 'until' is ambiguous: add parentheses, e.g. (a until[0:1] b) until[0:1] c", pos_);
+  }
+
+  // A future operator is monitored with a delay equal to its horizon
+  // (spec/pastify.hpp): without an upper bound no verdict would ever be known.
+  void check_future_bounds(const Bounds& b, const char* name, size_t at) const {
+    if (!b.explicit_bounds || b.hi == kInfinity)
+      fail("unbounded future: '" + std::string(name) + "' needs an upper time bound to be monitored online, e.g. " +
+               name + (std::string(name) == "until" ? "[0:5]" : "[0:5] {p}") +
+               " (its verdicts are then known 5 time units late)",
+           at);
   }
 
   // Optional "[a:b]", "[a:]", "[:b]" after a temporal operator.

@@ -3,7 +3,8 @@
 // Precedence, tightest first (matches Reelay 25, checked by differential tests):
 //   atoms {..}, true, false, ( )
 //   unary:  not ! pre Y once P historically H          (prefix, stackable)
-//   since S [a:b]                                      (non-associative: chains need parentheses)
+//           eventually[a:b] always[a:b] next            (bounded future, issue 29: spec/pastify.hpp)
+//   since S [a:b], until[a:b]                          (non-associative: chains need parentheses)
 //   and &&                                             (left-associative)
 //   or ||                                              (left-associative)
 //   implies ->                                         (right-associative)

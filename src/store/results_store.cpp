@@ -213,7 +213,7 @@ std::string ResultsStore::witness_json() const {
 }
 
 void ResultsStore::on_verdict(const std::string& property, double time, bool value,
-                              const std::vector<std::string>* explanation) {
+                              const std::vector<std::string>* explanation, double known_at) {
   auto [it, first] = last_value_.try_emplace(property, value ? 1 : 0);
   if (!first && it->second == (value ? 1 : 0)) return;
   it->second = value ? 1 : 0;
@@ -225,6 +225,7 @@ void ResultsStore::on_verdict(const std::string& property, double time, bool val
   v.number[0] = time;
   v.number[1] = wall;
   v.integer = value ? 1 : 0;
+  v.known_at = known_at;
   push(std::move(v));
   if (!value) {
     Row violation;
@@ -243,6 +244,7 @@ void ResultsStore::on_verdict(const std::string& property, double time, bool val
     }
     violation.number[0] = time;
     violation.number[1] = wall;
+    violation.known_at = known_at;
     push(std::move(violation));
   }
 }

@@ -16,6 +16,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <functional>
+#include <limits>
 #include <cstdint>
 #include <deque>
 #include <memory>
@@ -90,8 +91,10 @@ class ResultsStore {
   // A verdict: stored if it changes the property's value; a change to false
   // is also a violation, stored with the witness window.
   // `explanation`: --explain's sentences for a violation's start (else null).
+  // `known_at`: a delayed (bounded-future) verdict's known instant; NaN: `time`.
   void on_verdict(const std::string& property, double time, bool value,
-                  const std::vector<std::string>* explanation = nullptr);
+                  const std::vector<std::string>* explanation = nullptr,
+                  double known_at = std::numeric_limits<double>::quiet_NaN());
   // A counters snapshot (JSON object).
   void on_counters(std::string_view counters_json);
   // The run ended: final counters, exit status. Then waits for the writer to

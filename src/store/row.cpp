@@ -2,6 +2,8 @@
 
 #include <simdjson.h>
 
+#include <limits>
+
 #include "io/json_writer.hpp"
 
 namespace rvc::store {
@@ -22,13 +24,18 @@ std::string to_spool_line(const Row& row) {
     if (i) numbers += ',';
     io::append_number(numbers, row.number[i]);
   }
-  return io::JsonObject()
-      .add("table", table_name(row.table))
+  io::JsonObject line;
+  line.add("table", table_name(row.table))
       .add("run", row.run)
       .add_raw("text", texts + "]")
       .add_raw("number", numbers + "]")
-      .add("integer", row.integer)
-      .str();
+      .add("integer", row.integer);
+  if (row.known_at == row.known_at) {  // bounded future only: older spool readers see the same shape otherwise
+    std::string k;
+    io::append_number(k, row.known_at);
+    line.add_raw("known_at", k);
+  }
+  return line.str();
 }
 
 bool from_spool_line(std::string_view line, Row& row, std::string& error) {
@@ -77,6 +84,8 @@ bool from_spool_line(std::string_view line, Row& row, std::string& error) {
     row.number[i++] = d;
   }
   row.integer = integer;
+  double known_at = 0;
+  row.known_at = doc["known_at"].get(known_at) ? std::numeric_limits<double>::quiet_NaN() : known_at;
   return true;
 }
 

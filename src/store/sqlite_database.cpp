@@ -136,9 +136,12 @@ class SqliteDatabase final : public Database {
     switch (r.table) {
       case Table::Run: text(r.run), text(r.text[0]), text(r.text[1]), text(r.text[2]), real(r.number[0]); break;
       case Table::Property: text(r.run), text(r.text[0]), text(r.text[1]); break;
-      case Table::Verdict: text(r.run), text(r.text[0]), real(r.number[0]), integer(r.integer), real(r.number[1]); break;
+      case Table::Verdict:
+        text(r.run), text(r.text[0]), real(r.number[0]), integer(r.integer), real(r.number[1]), real(r.known());
+        break;
       case Table::Violation:
-        text(r.run), text(r.text[0]), real(r.number[0]), real(r.number[1]), text(r.text[1]), text(r.text[2]);
+        text(r.run), text(r.text[0]), real(r.number[0]), real(r.number[1]), text(r.text[1]), text(r.text[2]),
+            real(r.known());
         break;
       case Table::Counters: text(r.run), real(r.number[1]), text(r.text[0]); break;
       case Table::RunEnd: text(r.text[0]), text(r.text[1]), real(r.number[1]), integer(r.integer), text(r.run); break;

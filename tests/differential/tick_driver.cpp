@@ -9,8 +9,8 @@
 // With --deadlines the driver ticks as a runtime would: after each message
 // and tick, at next_deadline() while that is before the next message.
 // Output: one JSON line per verdict, {"property": "f<i>", "time": t,
-// "value": v} (v: true/false, or the robustness), and {"tick": T} for each
-// tick made at a deadline.
+// "value": v} (v: true/false, or the robustness; bounded future adds
+// "known_at"), and {"tick": T} for each tick made at a deadline.
 #include <simdjson.h>
 
 #include <cmath>
@@ -42,6 +42,10 @@ int main(int argc, char** argv) {
   engine::Checker checker(engine::TimeModel::Dense, false, [&](const engine::Verdict& v) {
     std::printf("{\"property\": \"%s\", \"time\": ", v.property.c_str());
     print_time(v.time);
+    if (!std::isnan(v.known_at)) {  // a bounded-future property's verdict: when it became known
+      std::printf(", \"known_at\": ");
+      print_time(v.known_at);
+    }
     if (v.robust) {
       std::printf(", \"value\": ");
       if (std::isinf(v.robustness)) std::printf("\"%s\"", v.robustness > 0 ? "inf" : "-inf");

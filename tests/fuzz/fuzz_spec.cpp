@@ -64,6 +64,7 @@ void check(const std::string& text, bool dense) {
         checker.step(atoms.data(), bound.data());
       }
     }
+    checker.finish();  // bounded future: settles the last horizon (the end marker's steps)
   } catch (const rvc::engine::data::DataLimitError&) {
   }
 }

@@ -34,10 +34,11 @@ SCHEMA = [
     "started_at DOUBLE PRECISION, ended_at DOUBLE PRECISION, exit_status INTEGER, end_reason TEXT, counters TEXT)",
     "CREATE TABLE IF NOT EXISTS properties (run TEXT NOT NULL, name TEXT NOT NULL, spec TEXT, PRIMARY KEY (run, name))",
     "CREATE TABLE IF NOT EXISTS verdicts (id INTEGER PRIMARY KEY AUTOINCREMENT, run TEXT NOT NULL, "
-    "property TEXT NOT NULL, time DOUBLE PRECISION, value INTEGER, wall DOUBLE PRECISION)",
+    "property TEXT NOT NULL, time DOUBLE PRECISION, value INTEGER, wall DOUBLE PRECISION, known_at DOUBLE PRECISION)",
     "CREATE INDEX IF NOT EXISTS verdicts_by_run ON verdicts (run, property, id)",
     "CREATE TABLE IF NOT EXISTS violations (id INTEGER PRIMARY KEY AUTOINCREMENT, run TEXT NOT NULL, "
-    "property TEXT NOT NULL, time DOUBLE PRECISION, wall DOUBLE PRECISION, witness TEXT, explanation TEXT)",
+    "property TEXT NOT NULL, time DOUBLE PRECISION, wall DOUBLE PRECISION, witness TEXT, explanation TEXT, "
+    "known_at DOUBLE PRECISION)",
     "CREATE INDEX IF NOT EXISTS violations_by_run ON violations (run, id)",
     "CREATE TABLE IF NOT EXISTS counters (id INTEGER PRIMARY KEY AUTOINCREMENT, run TEXT NOT NULL, "
     "wall DOUBLE PRECISION, counters TEXT)",
@@ -55,6 +56,11 @@ SNAPSHOTS = [  # run r-live: (wall, counters) for two inputs, interleaved
     (3003.0, {"input": "a", "received": 300, "checked": 290, "gaps": 2}),
     (3005.5, {"input": "b", "received": 60, "checked": 60, "gaps": 1}),
 ]
+
+
+def older(sql):
+    """A CREATE statement as an rvc before explanations and known_at (bounded future) wrote it."""
+    return sql.replace(", known_at DOUBLE PRECISION)", ")").replace(", explanation TEXT)", ")")
 
 
 def execute(path, sql, params=()):
@@ -236,11 +242,11 @@ def test_verdicts_after_and_property(dash):
 
     status, body = dash.get("/api/runs/r-mid/verdicts")
     assert body == {"run": "r-mid", "after": 0, "last_id": 5, "more": False, "verdicts": [
-        {"id": 1, "property": "p1", "time": 0, "value": True, "wall": 2001},
-        {"id": 2, "property": "p2", "time": 0, "value": True, "wall": 2001},
-        {"id": 3, "property": "p1", "time": 3, "value": False, "wall": 2003},
-        {"id": 4, "property": "p2", "time": 5, "value": False, "wall": 2005},
-        {"id": 5, "property": "p1", "time": 7, "value": True, "wall": 2007}]}
+        {"id": 1, "property": "p1", "time": 0, "value": True, "wall": 2001, "known_at": None},
+        {"id": 2, "property": "p2", "time": 0, "value": True, "wall": 2001, "known_at": None},
+        {"id": 3, "property": "p1", "time": 3, "value": False, "wall": 2003, "known_at": None},
+        {"id": 4, "property": "p2", "time": 5, "value": False, "wall": 2005, "known_at": None},
+        {"id": 5, "property": "p1", "time": 7, "value": True, "wall": 2007, "known_at": None}]}
     assert ids("/api/runs/r-mid/verdicts?after=2") == ([3, 4, 5], 5, False)
     assert ids("/api/runs/r-mid/verdicts?property=p1") == ([1, 3, 5], 5, False)
     assert ids("/api/runs/r-mid/verdicts?after=3&property=p1") == ([5], 5, False)
@@ -270,9 +276,9 @@ def test_violations_with_parsed_witness(dash):
     status, body = dash.get("/api/runs/r-mid/violations")
     assert status == 200 and body["last_id"] == 3 and body["more"] is False
     assert body["violations"] == [
-        {"id": 1, "property": "p1", "time": 3, "wall": 2003, "witness": WITNESS, "explanation": None},
-        {"id": 2, "property": "p2", "time": 5, "wall": 2005, "witness": HEX_WITNESS, "explanation": None},
-        {"id": 3, "property": "p2", "time": 9, "wall": 2009, "witness": "not json [", "explanation": None},  # as text
+        {"id": 1, "property": "p1", "time": 3, "wall": 2003, "witness": WITNESS, "explanation": None, "known_at": None},
+        {"id": 2, "property": "p2", "time": 5, "wall": 2005, "witness": HEX_WITNESS, "explanation": None, "known_at": None},
+        {"id": 3, "property": "p2", "time": 9, "wall": 2009, "witness": "not json [", "explanation": None, "known_at": None},  # as text
     ]
     status, body = dash.get("/api/runs/r-mid/violations?after=1&property=p2&limit=1")
     assert [v["id"] for v in body["violations"]] == [2] and body["more"] is True
@@ -368,9 +374,10 @@ def test_events_deliver_rows_inserted_after_connecting(dash, db):
         assert e is not None, f"events so far: {got}"
         got[e[0]] = e
     # (ev.next's timeout bounds the wait: rows arrive live, not at the end of a long poll)
-    assert got["verdict"][1] == [{"id": vid, "property": "p9", "time": 4.5, "value": False, "wall": 3010}]
+    assert got["verdict"][1] == [{"id": vid, "property": "p9", "time": 4.5, "value": False, "wall": 3010,
+                                  "known_at": None}]
     assert got["violation"][1] == [{"id": kid, "property": "p9", "time": 4.5, "wall": 3010, "witness": WITNESS,
-                                    "explanation": None}]
+                                    "explanation": None, "known_at": None}]
     assert [(c["id"], c["counters"]) for c in got["counters"][1]] == [(cid, {"input": "a", "received": 500})]
     assert got["counters"][1][0]["rates"] == {"seconds": 4, "received_per_s": 50, "checked_per_s": None}
     assert got["counters"][2] == f"{vid},{kid},{cid}"  # the cursor, for a reconnecting EventSource
@@ -551,7 +558,7 @@ def test_explanations_kept_and_an_older_database_gains_their_column(tmp_path):
     db = tmp_path / "old.db"
     with sqlite3.connect(db) as c:
         for sql in SCHEMA:
-            c.execute(sql.replace(", explanation TEXT)", ")"))
+            c.execute(older(sql))
     trace = tmp_path / "t.jsonl"
     trace.write_text("".join(json.dumps({"speed": s}) + "\n" for s in [10, 50]))
     r = subprocess.run([rvc_binary(), "check", "--explain", "-s", "{speed < 40}", "--output", f"sqlite:{db}",
@@ -573,7 +580,7 @@ def test_an_older_database_is_served_as_it_is(tmp_path):
     db = tmp_path / "old.db"
     with sqlite3.connect(db) as c:
         for sql in SCHEMA:
-            c.execute(sql.replace(", explanation TEXT)", ")"))
+            c.execute(older(sql))
         c.execute("INSERT INTO runs (run, command, started_at) VALUES ('r1', 'rvc check', 1)")
         c.execute("INSERT INTO violations (run, property, time, wall, witness) VALUES ('r1', 'p1', 3, 4, '[]')")
     before = hashlib.sha256(db.read_bytes()).hexdigest()
@@ -588,6 +595,39 @@ def test_an_older_database_is_served_as_it_is(tmp_path):
     finally:
         assert d.stop() == 0
     assert hashlib.sha256(db.read_bytes()).hexdigest() == before
+
+
+def test_delayed_verdicts_keep_known_at_and_an_older_database_gains_the_column(tmp_path):
+    """Bounded future (issue 29): a delayed verdict is stored with the instant it became known
+    (known_at), a past-only one with known_at = time; a database from before known_at (no such
+    column) is migrated by the next run; the API returns known_at (null for an older database's rows,
+    which the dashboard reads without migrating). Hand-computed: p at step 2 only, eventually[1:2]{p}
+    is true for 0 (known at 2) and false from 2 (known at 4)."""
+    db = tmp_path / "old.db"
+    with sqlite3.connect(db) as c:
+        for sql in SCHEMA:
+            c.execute(sql.replace(", known_at DOUBLE PRECISION)", ")"))  # explanations, no known_at
+        c.execute("INSERT INTO runs (run, command, started_at) VALUES ('r0', 'rvc check', 1)")
+        c.execute("INSERT INTO verdicts (run, property, time, value, wall) VALUES ('r0', 'p1', 3, 1, 4)")
+    trace = tmp_path / "t.jsonl"
+    trace.write_text("".join(json.dumps({"p": p}) + "\n" for p in [False, False, True, False, False]))
+    r = subprocess.run([rvc_binary(), "check", "-s", "eventually[1:2]{p}", "-s", "historically{p: false}",
+                        "--output", f"sqlite:{db}", str(trace)], capture_output=True, text=True, timeout=30)
+    assert r.returncode == 1, r.stderr
+    with sqlite3.connect(db) as c:
+        rows = c.execute("SELECT property, time, value, known_at FROM verdicts WHERE run != 'r0' ORDER BY id").fetchall()
+        assert rows == [("p2", 0, 1, 0), ("p1", 0, 1, 2), ("p2", 2, 0, 2), ("p1", 2, 0, 4)]
+        assert c.execute("SELECT property, time, known_at FROM violations ORDER BY id").fetchall() == [
+            ("p2", 2, 2), ("p1", 2, 4)]
+    d = Dashboard(f"sqlite:{db}")
+    try:
+        run = [x["run"] for x in d.get("/api/runs")[1]["runs"] if x["run"] != "r0"][0]
+        verdicts = d.get(f"/api/runs/{run}/verdicts")[1]["verdicts"]
+        assert [(v["property"], v["time"], v["known_at"]) for v in verdicts] == [
+            ("p2", 0, 0), ("p1", 0, 2), ("p2", 2, 2), ("p1", 2, 4)]
+        assert [v["known_at"] for v in d.get("/api/runs/r0/verdicts")[1]["verdicts"]] == [None]
+    finally:
+        assert d.stop() == 0
 
 
 # --- the same API over PostgreSQL ------------------------------------------------------------------

@@ -1,0 +1,172 @@
+#include "spec/pastify.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <utility>
+
+#include "spec/spec_error.hpp"
+
+namespace rvc::spec {
+
+double horizon(const Node& n) {
+  const double l = n.left ? horizon(*n.left) : 0;
+  const double r = n.right ? horizon(*n.right) : 0;
+  switch (n.op) {
+    case Op::Eventually:
+    case Op::Always: return n.bounds.hi + l;
+    case Op::Until: return n.bounds.hi + std::max(l, r);
+    case Op::Next: return 1 + l;
+    default: return std::max(l, r);
+  }
+}
+
+bool has_future(const Node& n) {
+  return n.is_future() || (n.left && has_future(*n.left)) || (n.right && has_future(*n.right));
+}
+
+namespace {
+
+struct Pastifier {
+  const FieldTest& end;
+  bool dense;
+  const std::string& source;
+
+  static NodePtr node(Op op, int column, NodePtr left = nullptr, NodePtr right = nullptr) {
+    auto n = std::make_unique<Node>();
+    n->op = op;
+    n->column = column;
+    n->left = std::move(left);
+    n->right = std::move(right);
+    return n;
+  }
+  static NodePtr bounded(Op op, double lo, double hi, int column, NodePtr left, NodePtr right = nullptr) {
+    auto n = node(op, column, std::move(left), std::move(right));
+    n->bounds.lo = lo;
+    n->bounds.hi = hi;
+    n->bounds.explicit_bounds = true;
+    return n;
+  }
+  // once[d:d] φ: φ's value d time units ago (φ itself when d = 0).
+  static NodePtr delayed(NodePtr f, double d, int column) {
+    if (d <= 0) return f;
+    return bounded(Op::Once, d, d, column, std::move(f));
+  }
+  // S(d): the time referred to (t − d) is not before the start.
+  static NodePtr started(double d, int column) { return bounded(Op::Once, d, kInfinity, column, node(Op::True, column)); }
+  // E(e): t − e is past the end of the stream.
+  NodePtr ended(double e, int column) const {
+    auto atom = node(Op::Test, column);
+    atom->test = end;
+    return delayed(std::move(atom), e, column);
+  }
+  static NodePtr both(NodePtr a, NodePtr b, int column) { return node(Op::And, column, std::move(a), std::move(b)); }
+  static NodePtr either(NodePtr a, NodePtr b, int column) { return node(Op::Or, column, std::move(a), std::move(b)); }
+  static NodePtr negate(NodePtr a, int column) { return node(Op::Not, column, std::move(a)); }
+
+  // A delay computed by subtracting dense bounds may miss the operand's
+  // horizon by a rounding error: snap to it (delays are never below it).
+  static double snap(double d, double h) {
+    if (std::abs(d - h) <= 1e-9 * std::max(1.0, std::abs(d))) return h;
+    return d;
+  }
+
+  NodePtr visit(const Node& n, double d) {
+    d = snap(d, horizon(n));
+    if (d < 1e-12) d = 0;
+    const int c = n.column;
+    switch (n.op) {
+      case Op::True:
+      case Op::False: return node(n.op, c);
+      case Op::Test: {
+        auto atom = node(Op::Test, c);
+        atom->test = n.test;
+        return delayed(std::move(atom), d, c);
+      }
+      case Op::Not: return negate(visit(*n.left, d), c);
+      case Op::And:
+      case Op::Or:
+      case Op::Implies: return node(n.op, c, visit(*n.left, d), visit(*n.right, d));
+      case Op::Exists:
+      case Op::Forall: {
+        auto q = node(n.op, c, visit(*n.left, d));
+        q->variables = n.variables;
+        return q;
+      }
+      case Op::Pre: return node(Op::Pre, c, guard_true(visit(*n.left, d), d, c));
+      case Op::Once:
+        return bounded(Op::Once, n.bounds.lo, n.bounds.hi, c, guard_true(visit(*n.left, d), d, c));
+      case Op::Historically:
+        return bounded(Op::Historically, n.bounds.lo, n.bounds.hi, c, guard_false(visit(*n.left, d), d, c));
+      case Op::Since: {
+        auto s = node(Op::Since, c, visit(*n.left, d), guard_true(visit(*n.right, d), d, c));
+        s->bounds = n.bounds;
+        return s;
+      }
+      case Op::Eventually: {
+        const double e = d - n.bounds.hi;
+        auto operand = both(visit(*n.left, e), negate(ended(e, c), c), c);
+        return window(Op::Once, n.bounds.hi - n.bounds.lo, std::move(operand), c);
+      }
+      case Op::Always: {
+        const double e = d - n.bounds.hi;
+        auto operand = either(visit(*n.left, e), ended(e, c), c);
+        return window(Op::Historically, n.bounds.hi - n.bounds.lo, std::move(operand), c);
+      }
+      case Op::Next: return both(visit(*n.left, d - 1), negate(ended(d - 1, c), c), c);
+      case Op::Until: return until(n, d);
+    }
+    return node(Op::False, c);
+  }
+
+  static NodePtr window(Op op, double width, NodePtr operand, int c) {
+    if (width <= 0) return operand;  // once[0:0] φ is φ
+    return bounded(op, 0, width, c, std::move(operand));
+  }
+  // Operands of past operators: false (once, since) or true (historically)
+  // where the time they refer to is before the start.
+  static NodePtr guard_true(NodePtr f, double d, int c) { return d > 0 ? both(std::move(f), started(d, c), c) : std::move(f); }
+  static NodePtr guard_false(NodePtr f, double d, int c) {
+    return d > 0 ? either(std::move(f), negate(started(d, c), c), c) : std::move(f);
+  }
+
+  // φ until[a:b] ψ at t − d: some J in [t−d+a, t−d+b] with ψ(J) and φ on
+  // [t−d, J). With both operands at delay e = d − b, J = t − (w − k) for k
+  // in 0..w and [t−d, J) is [t−b, t−(w−k)−1] in monitor time.
+  NodePtr until(const Node& n, double d) {
+    const int c = n.column;
+    if (dense)
+      throw SpecError("'until' is not supported in dense time yet (RTAMT's dense monitors lack it too); "
+                      "use discrete time, or eventually/always",
+                      source, c);
+    const double a = n.bounds.lo, b = n.bounds.hi, w = b - a;
+    if (w >= kMaxUntilWindow)
+      throw SpecError("until[a:b] with b - a >= " + std::to_string(static_cast<int>(kMaxUntilWindow)) +
+                          " is not supported: it is checked as b - a + 1 terms",
+                      source, c);
+    const double e = d - b;
+    NodePtr result;
+    for (double k = 0; k <= w; ++k) {
+      auto witness = delayed(both(visit(*n.right, e), negate(ended(e, c), c), c), w - k, c);
+      NodePtr term;
+      if (a + k > 0) {
+        // φ on the a + k steps before the witness.
+        auto held = bounded(Op::Historically, w - k + 1, b, c, visit(*n.left, e));
+        term = both(std::move(witness), std::move(held), c);
+      } else {
+        term = std::move(witness);
+      }
+      result = result ? either(std::move(result), std::move(term), c) : std::move(term);
+    }
+    return result;
+  }
+};
+
+}  // namespace
+
+NodePtr pastify(const Node& root, double h, const FieldTest& end_marker, bool dense, const std::string& source) {
+  Pastifier p{end_marker, dense, source};
+  return p.visit(root, h);
+}
+
+}  // namespace rvc::spec
