@@ -19,7 +19,7 @@ addresses only. The host talks to the routers through its gateway address on the
 import importlib.util
 import json
 import os
-import subprocess
+import sqlite3
 import sys
 import time
 
@@ -197,6 +197,10 @@ def test_fleet_group_in_containers_survives_a_killed_monitor_container(image, rv
         assert c["rejected"] == 0, c
         assert c["group"]["members"] == 2 and c["group"]["partial_replays"] == 0, c
         taken += c["group"]["handovers"]
+        db = sqlite3.connect(out / ("%s.db" % name))  # the results database records the handover
+        rows = [r[0] for r in db.execute("SELECT counters FROM counters") if '"handover"' in r[0]]
+        db.close()
+        assert rows and json.loads(rows[0])["handover"]["left"] == VICTIM, rows
         line = next(ln for ln in stamped[name].splitlines() if "left: %s" % VICTIM in ln)
         takeover.append(_seconds_after(line.split()[0], kill_sent))
     assert taken >= 2, "both survivors took part of %s's shards" % VICTIM
