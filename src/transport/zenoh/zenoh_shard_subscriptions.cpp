@@ -162,7 +162,7 @@ void ZenohShardSubscriptions::reconcile() {
         std::lock_guard lock(*mu);  // one input's samples of all shards: one handler call at a time
         handler(f);
       };
-      auto sub = std::make_unique<ZenohSubscriber>(session_, key, std::move(on_sample), false);
+      auto sub = std::make_unique<ZenohSubscriber>(session_, key, std::move(on_sample), true);  // announced: answers the flush barrier (docs/zenoh.md)
       std::lock_guard lock(mutex_);
       in->subs.emplace(shard, std::move(sub));
       ++added;
