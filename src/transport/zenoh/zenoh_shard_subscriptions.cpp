@@ -75,6 +75,10 @@ std::unique_ptr<Source> ZenohShardSubscriptions::source(const std::string& keyex
 
 void ZenohShardSubscriptions::started(Input* input, FrameHandler handler) {
   std::lock_guard lock(mutex_);
+  {
+    std::lock_guard in_lock(*input->mutex);
+    *input->closed = false;
+  }
   input->handler = std::move(handler);
   dirty_ = true;
   cv_.notify_all();
@@ -88,6 +92,8 @@ void ZenohShardSubscriptions::stopped(Input* input) {
     input->handler = nullptr;
   }
   subs.clear();  // undeclared outside the lock: a callback may be running
+  std::lock_guard lock(*input->mutex);
+  *input->closed = true;  // after this no handler call runs or will run
 }
 
 void ZenohShardSubscriptions::run() {
@@ -151,7 +157,7 @@ void ZenohShardSubscriptions::reconcile() {
         if (stop_ || !in->handler) return;
         handler = in->handler;
       }
-      auto on_sample = [handler, mu = in->mutex](const ZenohSample& s) {
+      auto on_sample = [handler, mu = in->mutex, closed = in->closed](const ZenohSample& s) {
         const auto a = decode_seq_attachment(reinterpret_cast<const uint8_t*>(s.attachment.data()), s.attachment.size());
         Frame f;
         f.seq = a.seq;
@@ -160,12 +166,20 @@ void ZenohShardSubscriptions::reconcile() {
         if (!a.eos) f.payload = s.payload;
         f.key = s.key;
         std::lock_guard lock(*mu);  // one input's samples of all shards: one handler call at a time
-        handler(f);
+        if (!*closed) handler(f);
       };
       auto sub = std::make_unique<ZenohSubscriber>(session_, key, std::move(on_sample), true);  // announced: answers the flush barrier (docs/zenoh.md)
-      std::lock_guard lock(mutex_);
-      in->subs.emplace(shard, std::move(sub));
-      ++added;
+      {
+        std::lock_guard lock(mutex_);
+        // The input may have stopped while this was declared: its handler
+        // (the loop's queue) must not outlive stop(), so the subscriber goes.
+        if (!stop_ && in->handler) {
+          in->subs.emplace(shard, std::move(sub));
+          ++added;
+          continue;
+        }
+      }
+      return;  // `sub` is undeclared here, outside the lock
     }
   }
   if (added || removed)

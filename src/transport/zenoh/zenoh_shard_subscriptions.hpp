@@ -48,6 +48,9 @@ class ZenohShardSubscriptions {
     std::string keyexpr;
     FrameHandler handler;  // set by start(); samples go here (serialised by mutex)
     std::shared_ptr<std::mutex> mutex = std::make_shared<std::mutex>();
+    // Set (under `mutex`) by stop(): a subscriber declared as the input
+    // stopped calls the handler no more.
+    std::shared_ptr<bool> closed = std::make_shared<bool>(false);
     std::map<std::string, std::unique_ptr<ZenohSubscriber>> subs;  // shard -> its subscriber
   };
   void started(Input* input, FrameHandler handler);
