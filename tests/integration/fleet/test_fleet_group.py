@@ -450,8 +450,9 @@ def test_owned_subscriptions_count_up_across_the_group(rvc, procs, tmp_path):
 
 
 def fleet_ranked(shard, members):
-    """Members in rendezvous order (fleet_owner's hash), highest first."""
-    first = fleet_owner(shard, members)
-    rest = [m for m in members if m != first]
-    return [first] + ([fleet_ranked(shard, rest)[0]] if rest else []) + \
-        (fleet_ranked(shard, rest)[1:] if len(rest) > 1 else [])
+    """Members in rendezvous order: the owner, then the owner of the rest (the backup), ..."""
+    order, rest = [], list(members)
+    while rest:
+        order.append(fleet_owner(shard, rest))
+        rest.remove(order[-1])
+    return order
