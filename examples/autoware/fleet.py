@@ -110,16 +110,19 @@ def publish(fleet, topics: dict, sessions, speed: float, prefix: str, settle: fl
     import zenoh
     by_name = {t["name"]: t for t in topics["topics"]}
     rng = random.Random()
-    pubs, events = {}, []
+    pubs, events, tokens = {}, [], []
     for v, (vid, _, msgs) in enumerate(fleet):
         session = sessions[v % len(sessions)]
+        # The vehicle announces itself (a liveliness token on its shard key, fleet/<id>): replicas
+        # with --shard-subscribe owned find their shards by these tokens (docs/fleet.md).
+        tokens.append(session.liveliness().declare_token(f"{prefix}/{vid}"))
         for name, lst in msgs.items():
             key = key_of(vid, by_name[name]["topic"], prefix)
             pub = session.declare_publisher(key, congestion_control=zenoh.CongestionControl.BLOCK)
             pubs[key] = [pub, rng.getrandbits(63) | 1, 0]
             events += [(ns, key, data) for ns, data in lst]
     events.sort(key=lambda e: e[0])
-    time.sleep(settle)  # the routers learn the publishers' subscribers
+    time.sleep(settle)  # the routers learn the publishers' subscribers (and replicas subscribe per vehicle)
     log(f"fleet: {len(fleet)} vehicles, {len(pubs)} publishers, {len(events)} messages over "
         f"{len(sessions)} router(s), speed {speed}")
     start_ns = events[0][0] if events else 0
@@ -147,6 +150,8 @@ def publish(fleet, topics: dict, sessions, speed: float, prefix: str, settle: fl
     elapsed = time.monotonic() - t0
     log(f"fleet: {answered} flush answers")
     log(f"fleet: sent {len(events)} messages in {elapsed:.2f} s ({len(events) / max(elapsed, 1e-9):.0f}/s)")
+    for token in tokens:
+        token.undeclare()
     return {key: p[2] for key, p in pubs.items()}
 
 

@@ -125,7 +125,12 @@ struct MonitorCommand {
     liveliness_token.reset();
     // Killed or stopped by a signal, the others take this replica's shards
     // over; at the end of the stream they keep them (it checked everything).
-    group.leave(loop.end_reason() == runtime::EndReason::EndOfStream);  // an orderly end: the token goes at once (a killed monitor's when its lease expires)
+    // --shard-subscribe owned: a replica sees only its shards' end-of-stream
+    // markers, so it ends at --idle-timeout once the fleet went quiet, and
+    // that too is an orderly end (docs/fleet.md).
+    const auto end = loop.end_reason();
+    group.leave(end == runtime::EndReason::EndOfStream ||
+                (group.subscribe_owned() && end == runtime::EndReason::IdleTimeout));  // an orderly end: the token goes at once (a killed monitor's when its lease expires)
     if (!diagnostics) return;
     try {
       diagnostics->finish(loop);
@@ -426,6 +431,11 @@ struct MonitorCommand {
     set_filter(lopts, uris);
     runtime::MonitorLoop loop(*feed, verdicts, stats_sink.get(), lopts);
     SyncFlags::Sources sources = SyncFlags::open_sources(named, per_input);
+    if (group.subscribe_owned())  // per shard, not the whole key space (docs/fleet.md)
+      for (size_t i = 0; i < named.size(); ++i) {
+        sources.owned[i] = group.owned_source(named[i].uri);
+        sources.list[i] = sources.owned[i].get();
+      }
     install_stop_signals();
     std::fprintf(stderr, "rvc monitor: %zu propert%s on %zu inputs (%s, sync %s) -> %zu output%s\n",
                  properties.size(), properties.size() == 1 ? "y" : "ies", named.size(), lopts.input.c_str(),
@@ -621,7 +631,7 @@ struct MonitorCommand {
                                       : pipeline;
     runtime::MonitorLoop loop(feed, verdicts, stats_sink.get(), lopts);
 
-    auto source = transport::open_source(input, input_transports);
+    auto source = group.subscribe_owned() ? group.owned_source(input) : transport::open_source(input, input_transports);
     install_stop_signals();
     std::fprintf(stderr, "rvc monitor: %zu propert%s on %s -> %zu output%s\n", properties.size(),
                  properties.size() == 1 ? "y" : "ies", input.c_str(), verdicts.size(), verdicts.size() == 1 ? "" : "s");

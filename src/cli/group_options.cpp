@@ -7,10 +7,20 @@
 #include "cli/option_ranges.hpp"
 #ifdef RVC_HAVE_ZENOH
 #include "transport/zenoh/zenoh_liveliness.hpp"
+#include "transport/zenoh/zenoh_shard_subscriptions.hpp"
 #include "transport/zenoh/zenoh_session.hpp"
 #endif
 
 namespace rvc::cli {
+namespace {
+
+// The key expression of a zenoh: URI (options after '?' are not part of it).
+std::string key_of(const std::string& uri) {
+  std::string key = uri.substr(uri.find(':') + 1);
+  return key.substr(0, key.find('?'));
+}
+
+}  // namespace
 
 void GroupFlags::add_to(CLI::App& app) {
   app.add_option("--group", name,
@@ -30,6 +40,12 @@ void GroupFlags::add_to(CLI::App& app) {
                  "the change are published again, marked \"handover\"")
       ->check(in_range(0, kMaxSeconds, "seconds"))
       ->capture_default_str();
+  app.add_option("--shard-subscribe", subscribe,
+                 "With --group: 'all' subscribes to the whole key space and drops the shards others own; 'owned' "
+                 "subscribes per shard to those this replica owns or backs up (shards found by the vehicles' "
+                 "liveliness tokens on the --shard-by key; docs/fleet.md)")
+      ->check(CLI::IsMember({"all", "owned"}))
+      ->capture_default_str();
 }
 
 std::string GroupFlags::refuse(const std::vector<std::string>& uris) const {
@@ -42,6 +58,13 @@ std::string GroupFlags::refuse(const std::vector<std::string>& uris) const {
   for (const auto& uri : uris)
     if (transport::scheme_of(uri) != "zenoh")
       return "--group shards Zenoh keys: '" + uri + "' is not a zenoh: input";
+  if (subscribe == "owned") {
+    const runtime::fleet::ShardPattern pattern(shard_by);
+    for (const auto& uri : uris)
+      if (!pattern.narrow(key_of(uri), shard_by))
+        return "--shard-subscribe owned: the key of '" + uri + "' must begin with --shard-by '" + shard_by +
+               "' ('*' where it has '*', its literals where it has literals) to be subscribed per shard";
+  }
   return "";
 }
 
@@ -50,6 +73,7 @@ runtime::fleet::ShardedOptions GroupFlags::sharded_options() const {
   o.group = name;
   o.replay_window = replay_window;
   o.handover_overlap = handover_overlap;
+  o.subscribe_owned = subscribe_owned();
   return o;
 }
 
@@ -83,11 +107,21 @@ void GroupFlags::join(const transport::TransportOptions& transports) {
       false);
   token_ = std::make_shared<transport::ZenohLivelinessToken>(session, prefix + member);
   session_ = session;
+  if (subscribe_owned())
+    shard_subs_ = std::make_shared<transport::ZenohShardSubscriptions>(
+        session, runtime::fleet::ShardPattern(shard_by), *members_, name);
   std::fprintf(stderr, "rvc monitor: group %s: member %s (token %s%s), shards by '%s'\n", name.c_str(),
                member.c_str(), prefix.c_str(), member.c_str(), shard_by.c_str());
 }
+
+std::unique_ptr<transport::Source> GroupFlags::owned_source(const std::string& uri) {
+  return std::static_pointer_cast<transport::ZenohShardSubscriptions>(shard_subs_)->source(key_of(uri));
+}
 #else
 void GroupFlags::join(const transport::TransportOptions&) {
+  throw std::invalid_argument("--group needs Zenoh: this rvc was built without it");
+}
+std::unique_ptr<transport::Source> GroupFlags::owned_source(const std::string&) {
   throw std::invalid_argument("--group needs Zenoh: this rvc was built without it");
 }
 #endif
@@ -108,6 +142,7 @@ void GroupFlags::leave(bool at_end_of_stream) {
 #else
   (void)at_end_of_stream;
 #endif
+  if (shard_subs_) std::static_pointer_cast<transport::ZenohShardSubscriptions>(shard_subs_)->close();
   byes_.reset();
   token_.reset();
   watch_.reset();

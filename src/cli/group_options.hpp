@@ -13,6 +13,7 @@
 
 #include "runtime/fleet/group_members.hpp"
 #include "runtime/fleet/sharded_feed.hpp"
+#include "transport/endpoint.hpp"
 #include "transport/transport_options.hpp"
 
 namespace rvc::cli {
@@ -23,6 +24,7 @@ struct GroupFlags {
   std::string member;      // --member (default: the Zenoh session id)
   size_t replay_window = 16384;
   double handover_overlap = 3;
+  std::string subscribe = "all";  // --shard-subscribe all|owned
 
   void add_to(CLI::App& app);
   bool given() const { return !name.empty(); }
@@ -32,6 +34,11 @@ struct GroupFlags {
   // Joins the group: the token, the member set. Throws on a Zenoh failure.
   void join(const transport::TransportOptions& transports);
   runtime::fleet::GroupMembers& members() { return *members_; }
+  bool subscribe_owned() const { return given() && subscribe == "owned"; }
+  // --shard-subscribe owned: the source of one zenoh: input, subscribed per
+  // owned and backed-up shard (transport/zenoh/zenoh_shard_subscriptions.hpp).
+  // Throws std::invalid_argument when its key cannot be narrowed per shard.
+  std::unique_ptr<transport::Source> owned_source(const std::string& uri);
   runtime::fleet::ShardedOptions sharded_options() const;
   // The properties of one shard's instance: "<shard>/<name>".
   static std::vector<engine::PropertySpec> shard_properties(const std::vector<engine::PropertySpec>& properties,
@@ -44,6 +51,7 @@ struct GroupFlags {
  private:
   std::unique_ptr<runtime::fleet::GroupMembers> members_;
   std::shared_ptr<void> session_, token_, watch_, byes_;
+  std::shared_ptr<void> shard_subs_;  // --shard-subscribe owned
 };
 
 }  // namespace rvc::cli

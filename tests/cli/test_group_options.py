@@ -17,6 +17,11 @@ def run(rvc, *args):
     (["--input", "file:/dev/null", "--group", "g", "--shard-by", "fleet/*"], "is not a zenoh: input"),
     (["--input", "zenoh:fleet/*/s", "--group", "g", "--shard-by", "fleet/*", "--forward", "p1"],
      "--forward republishes one input"),
+    # --shard-subscribe owned narrows each input key to one shard: '**' or one vehicle's key cannot be.
+    (["--input", "zenoh:fleet/**", "--group", "g", "--shard-by", "fleet/*", "--shard-subscribe", "owned"],
+     "the key of 'zenoh:fleet/**' must begin with --shard-by 'fleet/*'"),
+    (["--input", "zenoh:fleet/v07/s", "--group", "g", "--shard-by", "fleet/*", "--shard-subscribe", "owned"],
+     "the key of 'zenoh:fleet/v07/s' must begin"),
 ])
 def test_refused_before_joining(rvc, args, needle):
     r = run(rvc, *args)

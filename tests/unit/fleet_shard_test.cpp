@@ -201,5 +201,85 @@ TEST(ShardedFeed, ATakeoverOfAShardSeenFromMidStreamIsReportedPartial) {
   EXPECT_EQ(feed.owned(), 2u);
 }
 
+// --shard-subscribe owned: a shard's backup is its second rendezvous choice,
+// i.e. exactly the member that owns it once the owner leaves.
+TEST(Rendezvous, TheBackupIsTheOwnerOnceTheOwnerLeaves) {
+  const std::vector<std::string> members = {"a", "b", "c", "d"};
+  for (int i = 0; i < 300; ++i) {
+    const std::string shard = "fleet/v" + std::to_string(i);
+    const auto firsts = owners_of(shard, members, 2);
+    ASSERT_EQ(firsts.size(), 2u);
+    EXPECT_EQ(firsts[0], owner_of(shard, members));
+    std::vector<std::string> rest;
+    for (const auto& m : members)
+      if (m != firsts[0]) rest.push_back(m);
+    EXPECT_EQ(owner_of(shard, rest), firsts[1]) << shard;
+  }
+  EXPECT_EQ(owners_of("fleet/v1", {"only"}, 2), std::vector<std::string>{"only"});
+}
+
+TEST(ShardPattern, NarrowsAnInputKeyToOneShard) {
+  const ShardPattern p("fleet/*");
+  EXPECT_EQ(p.narrow("fleet/*/vehicle/status/gear", "fleet/v07"), "fleet/v07/vehicle/status/gear");
+  EXPECT_EQ(p.narrow("*/*/x", "fleet/v07"), "fleet/v07/x");
+  EXPECT_EQ(p.narrow("fleet/*", "fleet/v07"), "fleet/v07");
+  EXPECT_FALSE(p.narrow("fleet/**", "fleet/v07"));        // '**' spans shards
+  EXPECT_FALSE(p.narrow("fleet/v07/x", "fleet/v07"));     // one vehicle's key, not one per shard
+  EXPECT_FALSE(p.narrow("cars/*/x", "fleet/v07"));        // another prefix
+  EXPECT_FALSE(p.narrow("fleet", "fleet/v07"));           // too short
+  EXPECT_FALSE(p.narrow("fleet/v$*/x", "fleet/v07"));
+}
+
+// With subscribe_owned a replica keeps windows for the shards it backs up
+// only: the owner's departure then replays them whole, while a shard it
+// neither owned nor backed up (it got a few samples in flight) is partial.
+TEST(ShardedFeed, OwnedSubscriptionsKeepWindowsForBackedUpShardsOnly) {
+  GroupMembers members("self");
+  members.update("a", true);
+  members.update("b", true);
+  std::vector<std::string> lines;
+  std::vector<std::unique_ptr<transport::Sink>> sinks;
+  sinks.push_back(std::make_unique<LinesSink>(lines));
+  VerdictOutputs outputs(std::move(sinks), true);
+  ShardedOptions opts;
+  opts.subscribe_owned = true;
+  ShardedFeed feed(
+      ShardPattern("fleet/*"), members,
+      [&](const std::string& shard, engine::VerdictCallback cb) {
+        return std::make_unique<Pipeline>(std::vector<engine::PropertySpec>{{shard + "/p", "{ok}"}}, discrete(),
+                                          std::move(cb));
+      },
+      outputs, opts);
+  // backed: owner a, then self; third: owner a, then b, then self.
+  std::string backed, third;
+  for (int i = 0; backed.empty() || third.empty(); ++i) {
+    const std::string shard = "fleet/v" + std::to_string(i);
+    const auto r = owners_of(shard, {"a", "b", "self"}, 3);
+    if (r[0] != "a") continue;
+    (r[1] == "self" ? backed : third) = shard;
+  }
+  for (uint64_t seq = 1; seq <= 3; ++seq) {
+    feed.feed_keyed(0, backed + "/x", R"({"ok":true})", seq);
+    feed.feed_keyed(0, third + "/x", R"({"ok":true})", seq);
+  }
+  members.update("a", false);  // backed -> self (its window: 3 messages); third -> b, self its new backup
+  feed.follow_members();
+  io::JsonObject g;
+  feed.add_stats(g);
+  EXPECT_NE(g.str().find("\"owned\":1,\"handovers\":1,\"replayed\":3,"), std::string::npos) << g.str();
+  EXPECT_NE(g.str().find("\"partial_replays\":0}"), std::string::npos) << g.str();
+  feed.feed_keyed(0, third + "/x", R"({"ok":true})", 4);  // now backed up: kept from here on
+  members.update("b", false);
+  feed.follow_members();
+  io::JsonObject g2;
+  feed.add_stats(g2);
+  EXPECT_NE(g2.str().find("\"replayed\":4,"), std::string::npos) << g2.str();  // 3 + the one kept since
+  EXPECT_NE(g2.str().find("\"partial_replays\":1}"), std::string::npos) << g2.str();
+  io::JsonObject c;
+  feed.add_dropped(c);
+  EXPECT_EQ(c.str(), "{\"not owned\":7}");  // 3 + 3 before the change, 1 after
+  EXPECT_EQ(feed.received(), 7u);
+}
+
 }  // namespace
 }  // namespace rvc::runtime::fleet

@@ -1,5 +1,6 @@
 #include "runtime/fleet/shard_map.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 
 namespace rvc::runtime::fleet {
@@ -68,6 +69,38 @@ std::string owner_of(std::string_view shard, const std::vector<std::string>& mem
     }
   }
   return best ? *best : std::string();
+}
+
+std::vector<std::string> owners_of(std::string_view shard, const std::vector<std::string>& members, size_t n) {
+  std::vector<std::pair<uint64_t, const std::string*>> ranked;
+  ranked.reserve(members.size());
+  for (const auto& m : members) ranked.emplace_back(stable_hash(m, shard), &m);
+  // The same order as owner_of: highest hash first, ties to the smaller id.
+  std::sort(ranked.begin(), ranked.end(), [](const auto& a, const auto& b) {
+    return a.first != b.first ? a.first > b.first : *a.second < *b.second;
+  });
+  std::vector<std::string> out;
+  for (size_t i = 0; i < ranked.size() && i < n; ++i) out.push_back(*ranked[i].second);
+  return out;
+}
+
+std::optional<std::string> ShardPattern::narrow(std::string_view keyexpr, std::string_view shard) const {
+  size_t pos = 0;
+  for (size_t i = 0; i < chunks_.size(); ++i) {
+    if (pos > keyexpr.size()) return std::nullopt;
+    const size_t slash = keyexpr.find('/', pos);
+    const size_t end = slash == std::string_view::npos ? keyexpr.size() : slash;
+    const std::string_view chunk = keyexpr.substr(pos, end - pos);
+    // Each of the key's first chunks is '*' or the pattern's own literal;
+    // a literal where the pattern varies (one vehicle only), '**' or '$*'
+    // would not give one subscription per shard.
+    if (chunk.empty() || chunk == "**" || chunk.find('$') != std::string_view::npos) return std::nullopt;
+    if (chunk != "*" && (chunks_[i] == "*" || chunk != chunks_[i])) return std::nullopt;
+    pos = slash == std::string_view::npos ? keyexpr.size() + 1 : slash + 1;
+  }
+  std::string out(shard);
+  if (pos < keyexpr.size()) out += "/" + std::string(keyexpr.substr(pos));
+  return out;
 }
 
 }  // namespace rvc::runtime::fleet

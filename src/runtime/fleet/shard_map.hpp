@@ -26,6 +26,12 @@ class ShardPattern {
   // is shorter or a literal chunk differs.
   std::optional<std::string_view> shard_of(std::string_view key) const;
   const std::string& text() const { return text_; }
+  size_t chunks() const { return chunks_.size(); }
+  // `keyexpr` (an input's key expression) narrowed to one shard: its first
+  // chunks() chunks replaced by `shard` (`fleet/*/vehicle/x`, shard
+  // `fleet/v07` -> `fleet/v07/vehicle/x`), or nullopt when they cannot match
+  // the pattern (a literal differs, a '**' or '$*' among them, too short).
+  std::optional<std::string> narrow(std::string_view keyexpr, std::string_view shard) const;
 
  private:
   std::string text_;
@@ -39,5 +45,9 @@ uint64_t stable_hash(std::string_view a, std::string_view b);
 // The owner of `shard` among `members` (rendezvous hashing); "" when there
 // are none. Ties (equal hashes) go to the smaller member id.
 std::string owner_of(std::string_view shard, const std::vector<std::string>& members);
+
+// The first `n` choices for `shard` in rendezvous order: [0] is owner_of,
+// [1] the member that owns the shard when [0] leaves (its backup), ...
+std::vector<std::string> owners_of(std::string_view shard, const std::vector<std::string>& members, size_t n);
 
 }  // namespace rvc::runtime::fleet

@@ -75,13 +75,29 @@ void ShardedFeed::feed_keyed(uint32_t input, std::string_view key, std::string_v
     return;
   }
   ++not_owned_;
-  if (options_.replay_window == 0) return;
+  if (options_.replay_window == 0 || !keeps_window(s)) return;
   if (s.window.size() >= options_.replay_window) {
     s.window.pop_front();
     ++window_evicted_;
     s.evicted = true;
   }
   s.window.push_back(Buffered{input, position, std::chrono::steady_clock::now(), std::string(payload)});
+}
+
+bool ShardedFeed::keeps_window(Shard& s) {
+  if (!options_.subscribe_owned) return true;
+  if (!s.backup) {
+    // Only a shard's backup keeps its window; this one arrived here still
+    // (samples in flight as its subscription went, or the first of a shard
+    // whose role is not known yet): the first sight of a shard decides.
+    const auto firsts = owners_of(s.key, member_list_, 2);
+    s.backup = firsts.size() == 2 && firsts[1] == members_.self();
+    if (!s.backup) {
+      s.evicted = true;  // what it keeps later starts mid-history
+      return false;
+    }
+  }
+  return true;
 }
 
 void ShardedFeed::follow_members() {
@@ -113,6 +129,17 @@ void ShardedFeed::follow_members() {
     } else if (!mine && s->instance) {
       release(*s);
       ++released;
+    }
+    if (options_.subscribe_owned && !mine) {
+      // Backed up now, or no longer: a window kept while neither owner nor
+      // backup would have gaps (the shard was not subscribed), so it restarts.
+      const auto firsts = owners_of(key, member_list_, 2);
+      const bool backup = firsts.size() == 2 && firsts[1] == members_.self();
+      if (!backup || !s->backup) {
+        s->window.clear();
+        s->evicted = s->started;  // a started shard's later window lacks its beginning
+      }
+      s->backup = backup;
     }
   }
   std::fprintf(stderr,

@@ -40,6 +40,11 @@ struct ShardedOptions {
   std::string group;                 // the group's name (messages, counters)
   size_t replay_window = 16384;      // messages kept per shard this replica does not own
   double handover_overlap = 3;       // seconds: replayed messages this recent get their verdicts published
+  // --shard-subscribe owned: only the shards this replica owns or backs up
+  // (second rendezvous choice) arrive; windows are kept for the backed-up
+  // ones only, and a shard it stops backing up loses its window (it is not
+  // received any more: taken later, its replay is partial).
+  bool subscribe_owned = false;
   // Called on the engine thread at each handover (the results database
   // records it): the JSON object describing it.
   std::function<void(const std::string& json)> on_handover;
@@ -84,6 +89,7 @@ class ShardedFeed final : public Feed {
     std::string key;
     std::unique_ptr<Feed> instance;  // null: another replica owns it
     std::deque<Buffered> window;     // while not owned: the latest messages
+    bool backup = false;             // subscribe_owned: this replica is its second choice (keeps its window)
     bool evicted = false;            // the window lacks the shard's oldest messages: the replay starts mid-history
     bool started = false;            // its first message came: owned or not, it is known
     uint64_t inputs_seen = 0;        // inputs (bit i, the first 64) whose first message this replica has had
@@ -96,6 +102,7 @@ class ShardedFeed final : public Feed {
   void release(Shard& s);
   void on_verdict(const engine::Verdict& v);
   void retire(Shard& s);
+  bool keeps_window(Shard& s);
 
   ShardPattern pattern_;
   GroupMembers& members_;

@@ -344,3 +344,115 @@ def fleet_owner(shard, members):
         x ^= x >> 31
         return x
     return max(sorted(members), key=lambda m: h(m, shard))
+
+
+def owned_replica(rvc, procs, tmp_path, flags, group, name, port):
+    """A replica subscribing per owned and backed-up shard (--shard-subscribe owned): it sees only
+    its shards' end-of-stream markers, so it ends at --idle-timeout once the fleet is quiet."""
+    return procs([rvc, "monitor", *flags, "--sync", "merge",
+                  "--properties", os.path.join(EXAMPLE, "properties.yaml"),
+                  "--group", group, "--shard-by", "fleet/*", "--member", name, "--shard-subscribe", "owned",
+                  "--idle-timeout", "12", "--mode", "client", "--connect", ep(port), "--no-multicast-scouting",
+                  "-o", f"file:{tmp_path / name}.jsonl", "-o", f"sqlite:{tmp_path / name}.db"])
+
+
+def fleet_inputs(topics):
+    flags = []
+    for t in topics["topics"]:
+        flags += ["--input", f"{t['name']}=zenoh:fleet/*/{t['topic'].lstrip('/')}", "--type", t["type"]]
+    return flags
+
+
+def test_owned_subscriptions_survive_a_killed_replica_with_verdicts_equal_offline(rvc, procs, tmp_path):
+    """--shard-subscribe owned, 3 replicas, 30 vehicles, one replica killed mid-run: each survivor
+    received only the shards it owned or backed up (fewer samples than were sent), every sample of
+    those with no gap; the backup of each of the killed replica's shards had its whole window (an
+    exact replay), and every vehicle's verdicts equal `rvc check` of its own bag."""
+    vehicles = 30
+    topics = vehicle.load_topics()
+    ports = routers(rvc, procs)
+    flags = fleet_inputs(topics)
+    monitors = {n: owned_replica(rvc, procs, tmp_path, flags, "owned", n, ports[i])
+                for i, n in enumerate(["m1", "m2", "m3"])}
+    for m in monitors.values():
+        m.wait_for("members 3", timeout=30)
+    record = tmp_path / "fleet"
+    sim = procs([sys.executable, os.path.join(EXAMPLE, "fleet.py"), "run", "--vehicles", str(vehicles),
+                 *sum((["--connect", ep(p)] for p in ports), []), *sum((["--scenario", s] for s in SCENARIOS), []),
+                 "--duration", "10", "--speed", "2", "--settle", "3", "--record", str(record)])
+    sim.wait_for(f"fleet: {vehicles} vehicles", timeout=180)
+    time.sleep(2.5)
+    victim = monitors["m2"]
+    victim.p.send_signal(signal.SIGKILL)
+    victim.p.wait()
+    sim.p.wait(timeout=120)
+    assert sim.p.returncode == 0, sim.stderr()
+    survivors = {n: m for n, m in monitors.items() if m is not victim}
+    sent = json.loads((record / "sent.json").read_text())
+    total = sum(sent.values())
+    for name, m in survivors.items():
+        m.p.wait(timeout=120)
+        err = m.stderr()
+        assert m.p.returncode in (0, 1), err[-3000:]
+        assert "left: m2" in err and "subscribed to" in err, err[-3000:]
+        c = counters(err)
+        assert c["gaps"] == 0 and c["duplicates"] == 0 and c["rejected"] == 0, c
+        assert c["received"] == c["checked"] + sum(c["dropped"].values()), c
+        assert 0 < c["received"] < total, c  # not the whole key space
+        g = c["group"]
+        assert g["members"] == 2 and g["partial_replays"] == 0 and g["replayed"] > 0, g
+    live, _ = group_verdicts([tmp_path / f"{n}.jsonl" for n in monitors])
+    ids = json.loads((record / "vehicles.json").read_text())
+    differ = []
+    for vid in sorted(ids):
+        offline = offline_verdicts(rvc, record / vid / "bag", topics)
+        if live.get(vid) != offline:
+            differ.append((vid, ids[vid], sorted(set(offline.items()) ^ set(live.get(vid, {}).items()))[:4]))
+    assert not differ, differ
+
+
+def test_owned_subscriptions_count_up_across_the_group(rvc, procs, tmp_path):
+    """--shard-subscribe owned, 3 replicas, 12 vehicles, no kill: each replica receives exactly the
+    samples of the shards it owns (checked) or backs up ("not owned"), computed here from rvc's
+    rendezvous order written again; the owners' checked sum to what was sent; no handover at the end."""
+    vehicles = 12
+    topics = vehicle.load_topics()
+    ports = routers(rvc, procs, 2)
+    flags = fleet_inputs(topics)
+    names = ["o0", "o1", "o2"]
+    reps = {n: owned_replica(rvc, procs, tmp_path, flags, "count", n, ports[i % 2]) for i, n in enumerate(names)}
+    for r in reps.values():
+        r.wait_for("members 3", timeout=30)
+    record = tmp_path / "fleet"
+    sim = procs([sys.executable, os.path.join(EXAMPLE, "fleet.py"), "run", "--vehicles", str(vehicles),
+                 "--connect", ep(ports[0]), "--connect", ep(ports[1]), "--scenario", "drive",
+                 "--duration", "4", "--speed", "0", "--settle", "3", "--record", str(record)])
+    sim.p.wait(timeout=180)
+    assert sim.p.returncode == 0, sim.stderr()
+    sent = json.loads((record / "sent.json").read_text())
+    per_shard = {}
+    for key, n in sent.items():
+        shard = "/".join(key.split("/")[:2])
+        per_shard[shard] = per_shard.get(shard, 0) + n
+    checked = 0
+    for name, r in reps.items():
+        r.p.wait(timeout=120)
+        assert r.p.returncode == 0, r.stderr()[-2000:]
+        c = counters(r.stderr())
+        owned = sum(n for s, n in per_shard.items() if fleet_owner(s, names) == name)
+        backed = sum(n for s, n in per_shard.items() if fleet_ranked(s, names)[1] == name)
+        assert c["gaps"] == 0 and c["duplicates"] == 0, c
+        assert c["checked"] == owned and c["dropped"] == {"not owned": backed}, (name, c, owned, backed)
+        assert c["received"] == owned + backed, c
+        assert c["group"]["handovers"] == 0, c
+        checked += c["checked"]
+    assert checked == sum(sent.values())
+
+
+def fleet_ranked(shard, members):
+    """Members in rendezvous order: the owner, then the owner of the rest (the backup), ..."""
+    order, rest = [], list(members)
+    while rest:
+        order.append(fleet_owner(shard, rest))
+        rest.remove(order[-1])
+    return order
