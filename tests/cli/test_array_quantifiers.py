@@ -68,11 +68,13 @@ def test_discrete_boolean_and_robustness_by_hand(rvc, tmp_path):
 
 
 def test_dense_time_by_hand(rvc, tmp_path):
-    # once[0:1] over the instants 0, 0.5, 1.5, 2: count(..) == 0 held on [0.5, 1.5) only.
-    specs = {"recent_empty": "once[0:1]{count(objects[*].distance < 2) == 0}"}
+    # Instants 0, 0.5, 1.5, 2: count(..) == 0 holds on [0.5, 1.5) only, so once[0:0.4] of it holds at
+    # 0.5 and at 1.5 (the window [1.1, 1.5] meets it), and stops at 1.9 (--all also prints that instant).
+    specs = {"recent_empty": "once[0:0.4]{count(objects[*].distance < 2) == 0}"}
     r, got = run(rvc, tmp_path, ROWS, "--dense", specs=specs)
     assert r.returncode in (0, 1) and r.stderr == "", r.stderr
-    assert got["recent_empty"] == [False, True, True, False]
+    assert got["recent_empty"] == [False, True, True, False, False]
+    assert [json.loads(line)["time"] for line in r.stdout.splitlines()] == [0, 0.5, 1.5, 1.9, 2]
 
 
 def test_elements_without_a_value(rvc, tmp_path):
