@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <limits>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -188,6 +189,58 @@ TEST(ArrayQuantifiers, TypedSpecErrorsAtTheColumn) {
     EXPECT_EQ(e.column(), 21);
     EXPECT_NE(e.message().find("'x' is float64, not an array"), std::string::npos) << e.message();
   }
+}
+
+// A grammar fuzz of the quantifier forms: whatever parses prints to a fixed
+// point, and runs on a short trace (JSON, robustness too) without a crash.
+TEST(ArrayQuantifiers, TokenSoupParsesToAFixedPointOrASpecError) {
+  const char* tokens[] = {"{", "}", "all(", "any(", "count(", "a[*]", "o[*].d", "a[0]", "[*]", ")", "(", ",", "<",
+                          ">=", "==", "!=", "2", "-1.5", "\"s\"", "true", "x", "and", "or", "not", "once[0:2]",
+                          "{all(a[*] > 1)}", "{count(o[*].d < 2) >= 1}", "count[0:1](", "@age", ":", "*"};
+  std::mt19937 rng(2930);
+  int parsed = 0;
+  for (int i = 0; i < 3000; ++i) {
+    std::string s;
+    if (i % 2 == 0) {  // from the grammar, cut at a random point half the time
+      const char* quants[] = {"all(", "any(", "count("};
+      const char* paths[] = {"a[*]", "o[*].d", "a[*][1]", "\"k y\"[*]"};
+      const char* tests[] = {" > 1", " <= 2", " == \"s\"", "", ": true", " != -1.5"};
+      const char* joins[] = {" and ", " or ", " -> ", " since "};
+      for (int k = 1 + static_cast<int>(rng() % 3); k > 0; --k) {
+        const int q = static_cast<int>(rng() % 3);
+        s += std::string(rng() % 3 == 0 ? "once[0:2]" : "") + "{" + quants[q] + paths[rng() % 4] + tests[rng() % 6] +
+             ")" + (q == 2 ? " >= 2" : "") + "}" + (k > 1 ? joins[rng() % 4] : "");
+      }
+      if (rng() % 2) s = s.substr(0, rng() % (s.size() + 1));
+    } else {
+      for (int k = 1 + static_cast<int>(rng() % 10); k > 0; --k) {
+        s += tokens[rng() % (sizeof tokens / sizeof *tokens)];
+        if (rng() % 2) s += ' ';
+      }
+    }
+    spec::NodePtr ast;
+    try {
+      ast = spec::parse(s);
+    } catch (const spec::SpecError&) {
+      continue;
+    }
+    ++parsed;
+    const std::string printed = spec::to_string(*ast);
+    EXPECT_EQ(spec::to_string(*spec::parse(printed)), printed) << s;
+    runtime::PipelineOptions po;
+    po.robustness = i % 2 == 1;
+    testing::internal::CaptureStderr();
+    try {
+      runtime::Pipeline p({{"p", s}}, po, nullptr);
+      uint64_t n = 0;
+      for (const char* line : {R"({"a": [1, 3], "o": [{"d": 1}, {"d": "s"}], "x": 1})", R"({"a": 2, "o": []})",
+                               R"({"a": [], "o": [{"e": 1}, null]})", R"({"a": [true, null, {}], "o": [{"d": 0}]})"})
+        p.feed(line, ++n);
+    } catch (const std::exception&) {  // refused (e.g. a[*] with a[0]), never a crash
+    }
+    testing::internal::GetCapturedStderr();
+  }
+  EXPECT_GT(parsed, 500);
 }
 
 }  // namespace
