@@ -201,7 +201,7 @@ void JsonDecoder::prepare(KeyNode& node) {
       // An element read once can feed one subtree: "[*]" and "[N]" of one array cannot both be tested.
       for (const KeyNode& other : node.children)
         if (spec::is_index_part(other.name))
-          throw std::runtime_error("an array quantifier over \"" + node.name + "[*]\" and a test of its element \"" +
+          throw std::invalid_argument("an array quantifier over \"" + node.name + "[*]\" and a test of its element \"" +
                                    node.name + other.name + "\" in one run are not supported yet (JSON input)");
       continue;
     }

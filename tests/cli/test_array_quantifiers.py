@@ -90,6 +90,16 @@ def test_elements_without_a_value(rvc, tmp_path):
     assert "element 1" in r.stderr and "needs an array" in r.stderr, r.stderr
 
 
+def test_every_element_and_one_element_of_an_array_are_refused_together(rvc, tmp_path):
+    """Each element is read once: ranges[*] and ranges[0] in one run are refused (exit 2), never mis-evaluated."""
+    trace = tmp_path / "t.jsonl"
+    trace.write_text(json.dumps(ROWS[0]) + "\n")
+    r = subprocess.run([rvc, "check", "--spec", "{all(ranges[*] > 0.2)} && {ranges[0] > 1}", str(trace)],
+                       capture_output=True, text=True, timeout=60)
+    assert r.returncode == 2 and r.stdout == "", r.stderr
+    assert '"ranges[*]" and a test of its element "ranges[0]"' in r.stderr, r.stderr
+
+
 def caret_column(stderr):
     caret = next(line for line in stderr.splitlines() if line.strip() == "^")
     return len(caret) - len("  ^") + 1
