@@ -82,7 +82,8 @@ CdrDecoder::CdrDecoder(const engine::AtomTable& atoms, const MessageType& type, 
     // is the time of a type without one: bind_message_type let it through.
     if (options_.need_time && tests[id].path == split_path(options_.time_field) && !field_named(type, tests[id].path[0]))
       continue;
-    plan_path(tests[id].path).tests.push_back(static_cast<int>(id));
+    plan_path(tests[id].path, tests[id].is_quantified() ? static_cast<int>(id) : -1).tests.push_back(static_cast<int>(id));
+    if (tests[id].is_quantified() && folds_.empty()) folds_.resize(tests.size());
     if (tests[id].op == FOp::Present) presence_tests_.push_back(static_cast<int>(id));
     if (tests[id].op == FOp::Bind && bound_.empty()) bound_.assign(tests.size(), 0), next_bound_ = bound_;
   }
@@ -95,9 +96,13 @@ void CdrDecoder::index_thresholds(Plan& plan) {
 }
 
 void CdrDecoder::index_thresholds(FieldPlan& f) {
-  // Robustness wants every test's margin: no index then.
-  if (options_.threshold_index && !options_.robustness) f.thresholds.build(f.tests, atoms_.tests(), f.rest);
+  // Robustness wants every test's margin: no index then; nor for the elements of a quantifier (folded).
+  bool quantified = false;
+  for (int id : f.tests) quantified = quantified || atoms_.tests()[id].is_quantified();
+  if (quantified) f.rest = f.tests;
+  else if (options_.threshold_index && !options_.robustness) f.thresholds.build(f.tests, atoms_.tests(), f.rest);
   if (f.below) index_thresholds(*f.below);
+  if (f.each) index_thresholds(*f.each);
   for (auto& e : f.elements)
     if (e) index_thresholds(*e);
 }
@@ -132,12 +137,31 @@ std::string CdrDecoder::default_time_field(const MessageType& type, const std::s
 // The plan of the field at `path`, creating the nested plans on the way.
 // Paths were checked against the type (runtime::bind_message_type); one that
 // does not resolve is a programming error here, reported as a MsgError.
-CdrDecoder::FieldPlan& CdrDecoder::plan_path(const std::vector<std::string>& path) {
+CdrDecoder::FieldPlan& CdrDecoder::plan_path(const std::vector<std::string>& path, int quant_id) {
   FieldPlan* found = nullptr;
   for (size_t i = 0; i < path.size(); ++i) {
+    if (spec::is_every_part(path[i])) {  // every element of the array reached so far (a quantifier)
+      if (!found || found->type.array == ArrayKind::None)
+        throw msg::MsgError("'[*]' after a field that is no array");
+      if (!found->elements.empty())  // an element is read once: it can feed one plan
+        throw msg::MsgError("an array quantifier over '" + *found->name +
+                            "[*]' and a test of one of its elements in one run are not supported yet");
+      if (!found->each) {
+        found->each = std::make_unique<FieldPlan>();
+        found->each->type = found->type;
+        found->each->type.array = ArrayKind::None;
+        found->each->type.array_size = 0;
+      }
+      if (quant_id >= 0) found->quant_ids.push_back(quant_id);
+      found = found->each.get();
+      continue;
+    }
     if (spec::is_index_part(path[i])) {  // an element of the array reached so far
       if (!found || found->type.array == ArrayKind::None)
         throw msg::MsgError("an index into a field that is no array: " + path[i]);
+      if (found->each)
+        throw msg::MsgError("an array quantifier over '" + *found->name +
+                            "[*]' and a test of one of its elements in one run are not supported yet");
       const uint32_t index = spec::index_of_part(path[i]);
       if (found->elements.size() <= index) found->elements.resize(index + 1);
       if (!found->elements[index]) {
@@ -238,7 +262,7 @@ bool CdrDecoder::message(CdrCursor& in, const Plan& plan) {
 }
 
 bool CdrDecoder::planned_value(CdrCursor& in, const FieldPlan& f) {
-  if (f.below || !f.elements.empty()) {
+  if (f.below || !f.elements.empty() || f.each) {
     if (!(f.below ? message(in, *f.below) : indexed_array(in, f))) return false;
     // A message or array with tested parts inside answers only presence (as in JSON).
     for (int id : f.tests)
@@ -260,6 +284,17 @@ bool CdrDecoder::indexed_array(CdrCursor& in, const FieldPlan& f) {
   uint32_t n = t.array_size;
   if (t.array == ArrayKind::Unbounded && !in.count(n, cdr_min_size(t))) return false;
   if (t.array == ArrayKind::Bounded && !in.count(n, cdr_min_size(t), t.array_size)) return false;
+  if (f.each) {  // every element read with the "[*]" plan, its quantifiers folded
+    for (int id : f.quant_ids) quant_start(atoms_.tests()[id], folds_[id]);
+    for (uint32_t i = 0; i < n; ++i) {
+      in.push_index(i);
+      element_index_ = i;
+      if (!planned_value(in, *f.each)) return false;
+      for (int id : f.quant_ids) quant_element_done(folds_[id], i);
+      in.pop();
+    }
+    return finish_quantifiers(f, n);
+  }
   for (uint32_t i = 0; i < n; ++i) {
     in.push_index(i);
     const FieldPlan* element = i < f.elements.size() ? f.elements[i].get() : nullptr;
@@ -320,6 +355,10 @@ bool CdrDecoder::apply(const FieldPlan& f, const FieldValue& v) {
   }
   for (int id : *ids) {
     const spec::FieldTest& t = atoms_.tests()[id];
+    if (t.is_quantified()) {  // one element of its array: folded, finished by indexed_array
+      quant_element(t, v, element_index_, folds_[id]);
+      continue;
+    }
     const int result = evaluate_test(t, v);
     if (result >= 0) {
       next_[id] = static_cast<uint8_t>(result);
@@ -328,6 +367,27 @@ bool CdrDecoder::apply(const FieldPlan& f, const FieldValue& v) {
       continue;
     }
     const std::string problem = wrong_type_problem(t, v.kind);
+    if (options_.strict) {
+      *error_ = problem;
+      refused_ = true;
+      return false;
+    }
+    if (warnings_) warnings_->push_back(problem + "; it keeps its previous value");
+  }
+  return true;
+}
+
+// An array's quantifiers after its `elements` elements (as JsonDecoder's).
+bool CdrDecoder::finish_quantifiers(const FieldPlan& f, uint32_t elements) {
+  for (int id : f.quant_ids) {
+    double margin = 0;
+    std::string problem;
+    const int r = quant_finish(atoms_.tests()[id], folds_[id], elements, margin, problem);
+    if (r >= 0) {
+      next_[id] = static_cast<uint8_t>(r);
+      if (options_.robustness) next_margin_[id] = margin;
+      continue;
+    }
     if (options_.strict) {
       *error_ = problem;
       refused_ = true;

@@ -76,6 +76,10 @@ class CdrDecoder {
     std::vector<int> tests;             // atom ids testing this field
     std::unique_ptr<Plan> below;        // a nested message with tested (or time) fields inside
     std::vector<std::unique_ptr<FieldPlan>> elements;  // tested elements by index ({ranges[0]}), else null
+    // Array quantifiers (issue 29): the plan every element is read with
+    // ("[*]"), and the quantified tests below it, folded over the elements.
+    std::unique_ptr<FieldPlan> each;
+    std::vector<int> quant_ids;
     TimeRole time = TimeRole::None;
     // Comparisons with many constants, evaluated together for a number
     // (DecoderOptions::threshold_index); rest: the other tests.
@@ -87,7 +91,8 @@ class CdrDecoder {
     std::vector<FieldPlan> fields;  // one per field of the type, in wire order
   };
 
-  FieldPlan& plan_path(const std::vector<std::string>& path);
+  FieldPlan& plan_path(const std::vector<std::string>& path, int quant_id = -1);
+  bool finish_quantifiers(const FieldPlan& f, uint32_t elements);
   void plan_time(const std::string& time_field);
   bool message(CdrCursor& in, const Plan& plan);
   bool tested_field(CdrCursor& in, const FieldPlan& f);
@@ -113,6 +118,8 @@ class CdrDecoder {
   double sec_ = 0, nanosec_ = 0;
   bool malformed_ = false;
   bool refused_ = false;  // a strict-mode problem, not a bad sample
+  std::vector<QuantFold> folds_;  // per atom, sized when some test is an array quantifier
+  uint32_t element_index_ = 0;    // the element being read with a "[*]" plan
   std::string* error_ = nullptr;               // of the decode in progress
   std::vector<std::string>* warnings_ = nullptr;
 };

@@ -1,5 +1,6 @@
 #include "io/field_tests.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -103,6 +104,87 @@ double test_margin(const spec::FieldTest& t, const FieldValue& v) {
   const int b = evaluate_test(t, v);  // the rest is all or nothing
   if (b < 0) return std::numeric_limits<double>::quiet_NaN();
   return b ? inf : -inf;
+}
+
+// ---- Array quantifiers ----
+
+void quant_start(const spec::FieldTest& t, QuantFold& fold) {
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  fold = QuantFold{};
+  // The empty array: all is true (+inf, the min of nothing), any false (-inf).
+  fold.margin = t.quant.kind == spec::ArrayQuant::Kind::All ? inf : -inf;
+}
+
+void quant_element(const spec::FieldTest& t, const FieldValue& v, uint32_t index, QuantFold& fold) {
+  fold.seen = index + 1;
+  const int r = evaluate_test(t, v);
+  // null is no value here, as a missing field (there is no previous value of an element to keep)
+  if (r < 0 || v.kind == ValueKind::Null) {
+    if (fold.bad_element < 0) fold.bad_element = index, fold.bad_kind = v.kind;
+    return;
+  }
+  ++fold.evaluated;
+  fold.hits += static_cast<uint32_t>(r);
+  const double m = test_margin(t, v);
+  if (t.quant.kind == spec::ArrayQuant::Kind::All) fold.margin = std::min(fold.margin, m);
+  else if (t.quant.kind == spec::ArrayQuant::Kind::Any) fold.margin = std::max(fold.margin, m);
+}
+
+namespace {
+
+// The array part and the element part of a quantified path: "objects", ".distance".
+void split_every(const spec::FieldTest& t, std::string& array, std::string& rest) {
+  spec::FieldTest a;
+  a.path = t.path;
+  size_t i = 0;
+  while (i < a.path.size() && !spec::is_every_part(a.path[i])) ++i;
+  spec::FieldTest r;
+  r.path.assign(a.path.begin() + static_cast<long>(std::min(i + 1, a.path.size())), a.path.end());
+  a.path.resize(i);
+  array = a.key();
+  rest = r.key();
+}
+
+}  // namespace
+
+int quant_finish(const spec::FieldTest& t, QuantFold& fold, uint32_t elements, double& margin, std::string& problem) {
+  using K = spec::ArrayQuant::Kind;
+  if (fold.bad_element >= 0) {
+    std::string array, rest;
+    split_every(t, array, rest);
+    const std::string element = "element " + std::to_string(fold.bad_element) + " of \"" + array + "\"";
+    const std::string what = fold.bad_missing ? "missing" : value_kind_name(fold.bad_kind);
+    problem = rest.empty() ? element + " is " + what
+                           : "field \"" + rest.substr(rest[0] == '.' ? 1 : 0) + "\" of " + element + " is " + what;
+    problem += ", but {" + t.to_string() + "} needs a usable value in every element";
+    return -1;
+  }
+  const double hits = fold.hits;
+  switch (t.quant.kind) {
+    case K::All: margin = fold.margin; return fold.hits == elements;
+    case K::Any: margin = fold.margin; return fold.hits > 0;
+    case K::Count: {  // as a number field compared with the count's literal
+      const double k = t.quant.count_value;
+      switch (static_cast<FOp>(t.quant.count_op)) {
+        case FOp::Eq: margin = -std::fabs(hits - k); return hits == k;
+        case FOp::Ne: margin = std::fabs(hits - k); return hits != k;
+        case FOp::Lt: margin = k - hits; return hits < k;
+        case FOp::Le: margin = k - hits; return hits <= k;
+        case FOp::Gt: margin = hits - k; return hits > k;
+        case FOp::Ge: margin = hits - k; return hits >= k;
+        default: break;
+      }
+      break;
+    }
+    default: break;
+  }
+  return -1;
+}
+
+std::string not_an_array_problem(const spec::FieldTest& t, ValueKind kind) {
+  std::string array, rest;
+  split_every(t, array, rest);
+  return "field \"" + array + "\" is " + value_kind_name(kind) + ", but {" + t.to_string() + "} needs an array";
 }
 
 }  // namespace rvc::io

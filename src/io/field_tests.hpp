@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cmath>
+#include <cstdint>
 #include <string>
 #include <string_view>
 
@@ -64,6 +65,36 @@ int evaluate_test(const spec::FieldTest& test, const FieldValue& value);
 // number, a Boolean 1 or 0. NaN: a type the test cannot use (as
 // evaluate_test's -1).
 double test_margin(const spec::FieldTest& test, const FieldValue& value);
+
+// An array quantifier's fold over the elements of one array (issue 29,
+// spec::ArrayQuant): each element's test, then the atom's value and margin.
+// An element without a value the test can use (its field missing, null, or
+// of the wrong type) makes the whole atom unusable for this message: it
+// keeps its previous value (with a warning), or strict mode rejects it.
+struct QuantFold {
+  uint32_t evaluated = 0;       // elements whose test had a value
+  uint32_t hits = 0;            // ... that passed
+  double margin = 0;            // all: min of the element margins; any: max
+  uint32_t seen = 0;            // elements that had the field at all
+  int64_t bad_element = -1;     // the first element without a usable value
+  ValueKind bad_kind = ValueKind::Null;
+  bool bad_missing = false;     // ... because its field is missing
+};
+// After element `index` was decoded: did it have the field?
+inline void quant_element_done(QuantFold& fold, uint32_t index) {
+  if (fold.seen > index) return;
+  if (fold.bad_element < 0) fold.bad_element = index, fold.bad_missing = true;
+  fold.seen = index + 1;
+}
+void quant_start(const spec::FieldTest& test, QuantFold& fold);
+// One element's value (`index`: its position, for the error).
+void quant_element(const spec::FieldTest& test, const FieldValue& value, uint32_t index, QuantFold& fold);
+// The array had `elements` elements: the atom's value (1 or 0; -1 with
+// `problem` set when some element had no usable value) and its margin.
+int quant_finish(const spec::FieldTest& test, QuantFold& fold, uint32_t elements, double& margin,
+                 std::string& problem);
+// "field "ranges" is a string, but {all(ranges[*] > 0.2)} needs an array"
+std::string not_an_array_problem(const spec::FieldTest& test, ValueKind kind);
 
 // "field "speed" is a string, but {speed > 3} needs a number"
 std::string wrong_type_problem(const spec::FieldTest& test, ValueKind kind);

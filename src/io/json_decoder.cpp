@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 #include <cstring>
 
@@ -132,8 +133,12 @@ JsonDecoder::JsonDecoder(const engine::AtomTable& atoms, DecoderOptions options)
   for (size_t id = 0; id < tests.size(); ++id) {
     if (tests[id].is_timed()) continue;  // timing atoms and aggregates: the runtime's (engine/timed)
     KeyNode* node = &root_;
-    for (const std::string& part : tests[id].path) node = child(*node, part);
+    for (const std::string& part : tests[id].path) {
+      if (spec::is_every_part(part)) node->quant_ids.push_back(static_cast<int>(id));  // the array's
+      node = child(*node, part);
+    }
     node->tests.push_back(static_cast<int>(id));
+    if (tests[id].is_quantified() && folds_.empty()) folds_.resize(tests.size());
     if (tests[id].op == FOp::Present) presence_tests_.push_back(static_cast<int>(id));
     if (tests[id].op == FOp::Bind && bound_.empty()) bound_.assign(tests.size(), 0), next_bound_ = bound_;
   }
@@ -190,6 +195,16 @@ void JsonDecoder::remember(KeyNode& node, size_t position, simdjson::ondemand::r
 void JsonDecoder::prepare(KeyNode& node) {
   for (KeyNode& c : node.children) prepare(c);
   for (KeyNode& c : node.children) {
+    if (spec::is_every_part(c.name)) {
+      c.is_index = true;  // not a key
+      node.each = &c;
+      // An element read once can feed one subtree: "[*]" and "[N]" of one array cannot both be tested.
+      for (const KeyNode& other : node.children)
+        if (spec::is_index_part(other.name))
+          throw std::invalid_argument("an array quantifier over \"" + node.name + "[*]\" and a test of its element \"" +
+                                   node.name + other.name + "\" in one run are not supported yet (JSON input)");
+      continue;
+    }
     c.is_index = spec::is_index_part(c.name);
     if (!c.is_index) continue;
     const uint32_t i = spec::index_of_part(c.name);
@@ -199,6 +214,8 @@ void JsonDecoder::prepare(KeyNode& node) {
   for (KeyNode& c : node.children) node.any_escaped_child = node.any_escaped_child || !c.raw_comparable;
   node.raw_comparable = node.name.find_first_of("\"\\") == std::string::npos;
   if (node.tests.empty() || !node.children.empty() || node.time_part) return;
+  for (int id : node.tests)  // each element's tests fold (apply_value): no fast path
+    if (atoms_.tests()[id].is_quantified()) return;
   bool all_bool = true, all_number = true;
   for (int id : node.tests) {
     const spec::FieldTest& t = atoms_.tests()[id];
@@ -368,6 +385,11 @@ bool JsonDecoder::decode_value(KeyNode& target, simdjson::ondemand::value value,
       return false;
     return true;
   }
+  if (!target.quant_ids.empty() && type != json_type::array) {
+    if (!not_an_array(target, kind_of(type), error, warnings)) return false;
+    if (auto err = validate(value)) return invalid(error, err, target.name);
+    return true;
+  }
   if (target.time_part == 1) {
     double t;
     if (type == json_type::object) {  // a builtin_interfaces/Time: its parts come as its children
@@ -412,7 +434,7 @@ bool JsonDecoder::decode_value(KeyNode& target, simdjson::ondemand::value value,
     }
     return true;
   }
-  if (type == json_type::array && !target.by_index.empty()) {  // {ranges[0] < 0.5}
+  if (type == json_type::array && (!target.by_index.empty() || target.each)) {  // {ranges[0] < 0.5}
     simdjson::ondemand::array elements;
     if (auto err = value.get_array().get(elements)) {
       return invalid(error, err);
@@ -442,6 +464,19 @@ bool JsonDecoder::decode_value(KeyNode& target, simdjson::ondemand::value value,
 // its tests' values, like a missing field.
 bool JsonDecoder::decode_array(simdjson::ondemand::array elements, KeyNode& node, std::string& error,
                                std::vector<std::string>* warnings) {
+  if (node.each) {  // every element into "[*]", its quantifiers folded
+    for (int id : node.quant_ids) quant_start(atoms_.tests()[id], folds_[id]);
+    uint32_t n = 0;
+    for (auto element : elements) {
+      simdjson::ondemand::value v;
+      if (auto err = std::move(element).get(v)) return invalid(error, err, node.name);
+      element_index_ = n;
+      if (!decode_value(*node.each, v, error, warnings)) return false;
+      for (int id : node.quant_ids) quant_element_done(folds_[id], n);
+      ++n;
+    }
+    return finish_quantifiers(node, n, error, warnings);
+  }
   size_t i = 0;
   for (auto element : elements) {
     simdjson::ondemand::value v;
@@ -486,6 +521,10 @@ bool JsonDecoder::apply_value(KeyNode& node, const FieldValue& v, std::string& e
                               std::vector<std::string>* warnings) {
   for (int id : node.tests) {
     const spec::FieldTest& t = atoms_.tests()[id];
+    if (t.is_quantified()) {  // one element of its array: folded, finished by decode_array
+      quant_element(t, v, element_index_, folds_[id]);
+      continue;
+    }
     const int result = evaluate_test(t, v);  // -1: wrong type, the test keeps its previous value
     if (result >= 0) {
       next_[id] = static_cast<uint8_t>(result);
@@ -504,8 +543,47 @@ bool JsonDecoder::apply_value(KeyNode& node, const FieldValue& v, std::string& e
   return true;
 }
 
+// An array's quantifiers after its `elements` elements: their values, or
+// (an element without a usable value) the problem, as a wrong-type field.
+bool JsonDecoder::finish_quantifiers(const KeyNode& node, uint32_t elements, std::string& error,
+                                     std::vector<std::string>* warnings) {
+  for (int id : node.quant_ids) {
+    double margin = 0;
+    std::string problem;
+    const int r = quant_finish(atoms_.tests()[id], folds_[id], elements, margin, problem);
+    if (r >= 0) {
+      next_[id] = static_cast<uint8_t>(r);
+      if (options_.robustness) next_margin_[id] = margin;
+      continue;
+    }
+    if (options_.strict) {
+      error = problem;
+      return false;
+    }
+    if (warnings) warnings->push_back(problem + "; it keeps its previous value");
+  }
+  return true;
+}
+
+// The field an array quantifier reads is no array: its quantifiers keep
+// their values (null silently, as a missing field), or strict mode rejects.
+bool JsonDecoder::not_an_array(const KeyNode& node, ValueKind kind, std::string& error,
+                               std::vector<std::string>* warnings) {
+  if (kind == ValueKind::Null && !options_.strict) return true;
+  for (int id : node.quant_ids) {
+    const std::string problem = not_an_array_problem(atoms_.tests()[id], kind);
+    if (options_.strict) {
+      error = problem;
+      return false;
+    }
+    if (warnings) warnings->push_back(problem + "; it keeps its previous value");
+  }
+  return true;
+}
+
 bool JsonDecoder::check_missing(const KeyNode& node, const std::string& prefix, std::string& error) const {
   for (const KeyNode& c : node.children) {
+    if (&c == node.each) continue;  // elements without the field: the quantifier's fold reports them
     std::string path = prefix.empty() ? c.name : c.is_index ? prefix + c.name : prefix + "." + c.name;
     bool needed = false;
     for (int id : c.tests) needed = needed || atoms_.tests()[id].op != FOp::Present;

@@ -17,6 +17,7 @@
 
 #include "engine/atom_table.hpp"
 #include "io/bound_values.hpp"
+#include "io/field_tests.hpp"
 #include "io/json_layout.hpp"
 #include "io/threshold_index.hpp"
 
@@ -118,6 +119,10 @@ class JsonDecoder {
     uint32_t seen = 0;               // message generation when last present (strict mode)
     bool is_index = false;           // an array element: name "[N]"
     std::vector<KeyNode*> by_index;  // the element children by index (null: not tested)
+    // Array quantifiers (issue 29): the child "[*]" every element is decoded
+    // into, and the quantified tests below it, folded over the elements.
+    KeyNode* each = nullptr;
+    std::vector<int> quant_ids;
   };
   // A layout with the fields its slots feed (the other slots are only checked).
   struct SlotUse {
@@ -157,6 +162,9 @@ class JsonDecoder {
   bool apply_tests(KeyNode& node, simdjson::ondemand::value value, simdjson::ondemand::json_type type,
                    std::string& error, std::vector<std::string>* warnings);
   bool check_missing(const KeyNode& node, const std::string& prefix, std::string& error) const;
+  bool finish_quantifiers(const KeyNode& node, uint32_t elements, std::string& error,
+                          std::vector<std::string>* warnings);
+  bool not_an_array(const KeyNode& node, ValueKind kind, std::string& error, std::vector<std::string>* warnings);
 
   const engine::AtomTable& atoms_;
   DecoderOptions options_;
@@ -166,6 +174,8 @@ class JsonDecoder {
   std::vector<uint32_t> bound_, next_bound_;  // sized only when some test binds
   BoundValues bound_ids_;
   std::vector<double> margin_, next_margin_;
+  std::vector<QuantFold> folds_;  // per atom, sized when some test is an array quantifier
+  uint32_t element_index_ = 0;    // the element being decoded into a "[*]" node
   double time_ = 0, next_time_ = 0;
   bool saw_time_ = false;
   double time_sec_ = 0, time_nsec_ = 0;  // parts of a Time object

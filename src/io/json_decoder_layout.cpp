@@ -64,6 +64,7 @@ bool JsonDecoder::learn_value(simdjson::ondemand::value value, KeyNode* node, La
   json_type type;
   if (value.type().get(type)) return false;
   if (node && node->time_part >= 2) return false;  // a Time object's parts
+  if (node && node->each) return false;  // an array quantifier's array: its length varies (decode() folds it)
   switch (type) {
     case json_type::object: {
       if (node && (!node->tests.empty() || node->time_part)) return false;

@@ -30,6 +30,7 @@ std::string list_constants(const MessageType& t) {
 std::optional<spec::Literal> check_test(const spec::FieldTest& test, const MessageType& root, bool dense,
                                         const std::string& time_field, const std::string& text) {
   if (dense && test.path.size() == 1 && test.path[0] == time_field) return std::nullopt;
+
   // Walk the path: `holder` is the message whose field was named last (its
   // constants are the ones a bare word may name), `value` the type of what
   // the path has reached so far (a field, or an element of an array field).
@@ -38,6 +39,16 @@ std::optional<spec::Literal> check_test(const spec::FieldTest& test, const Messa
   std::string reached;  // the path so far, for errors
   for (size_t i = 0; i < test.path.size(); ++i) {
     const std::string& part = test.path[i];
+    if (spec::is_every_part(part)) {  // every element, in an array quantifier
+      if (value.array == ArrayKind::None)
+        throw spec::SpecError("field '" + test.key() + "': '" + reached + "' is " + value.to_string() +
+                                  ", not an array",
+                              text, test.column);
+      value.array = ArrayKind::None;
+      value.array_size = 0;
+      reached += part;
+      continue;
+    }
     if (spec::is_index_part(part)) {
       if (value.array == ArrayKind::None)
         throw spec::SpecError("field '" + test.key() + "': '" + reached + "' is " + value.to_string() +

@@ -60,7 +60,7 @@ std::string bounds_text(const Bounds& b) {
 std::string path_text(const std::vector<std::string>& path) {
   std::string out;
   for (size_t i = 0; i < path.size(); ++i) {
-    if (is_index_part(path[i])) out += path[i];
+    if (is_index_part(path[i]) || is_every_part(path[i])) out += path[i];
     else out.append(i ? "." : "").append(quote_if_needed(path[i]));
   }
   return out;
@@ -128,6 +128,15 @@ const char* timed_name(Timed::Kind kind) {
   }
 }
 
+const char* quant_name(ArrayQuant::Kind kind) {
+  switch (kind) {
+    case ArrayQuant::Kind::All: return "all";
+    case ArrayQuant::Kind::Any: return "any";
+    case ArrayQuant::Kind::Count: return "count";
+    default: return "";
+  }
+}
+
 const char* func_name(Timed::Func func) {
   switch (func) {
     case Timed::Func::Count: return "count";
@@ -150,7 +159,7 @@ std::string FieldTest::key() const {
   const bool names_atom = is_timed() && (timed.kind != Timed::Kind::Aggregate || timed.of_arrivals);
   std::string out;
   for (size_t i = 0; i < path.size(); ++i) {
-    if (is_index_part(path[i])) out += path[i];
+    if (is_index_part(path[i]) || is_every_part(path[i])) out += path[i];
     // A timing atom's name is written bare; a field named "@age" is quoted.
     else if (i + 1 == path.size() && names_atom) out.append(i ? "." : "").append(path[i]);
     else out.append(i ? "." : "").append(quote_if_needed(path[i]));
@@ -166,6 +175,14 @@ std::string FieldTest::to_string() const {
     // A quoted key there would read as a string too: {a < ("k y")}.
     if (rhs->kind == Expr::Kind::Field && (op == Op::Eq || op == Op::Ne || right[0] == '"')) right = "(" + right + ")";
     return spec::to_string(*lhs) + comparison_text(op) + right;
+  }
+  if (is_quantified()) {  // all(ranges[*] > 0.2), count(a[*].x < 2) >= 3
+    FieldTest element = *this;
+    element.quant = {};
+    std::string out = std::string(quant_name(quant.kind)) + "(" + element.to_string() + ")";
+    if (quant.kind == ArrayQuant::Kind::Count)
+      out += std::string(comparison_text(static_cast<Op>(quant.count_op))) + number_text(quant.count_value);
+    return out;
   }
   std::string k = key();
   if (timed.kind == Timed::Kind::Aggregate) k = std::string(func_name(timed.func)) + bounds_text(timed.window) + "(" + k + ")";

@@ -37,6 +37,22 @@ struct Literal {
 // be one, since the parser refuses a quoted key of that form.
 bool is_index_part(const std::string& part);
 uint32_t index_of_part(const std::string& part);  // "[12]" -> 12
+// "[*]": every element of the array, in an array quantifier (ArrayQuant).
+inline constexpr const char* kEveryElement = "[*]";
+inline bool is_every_part(const std::string& part) { return part == kEveryElement; }
+
+// An array quantifier (issue 29): the test's path has one "[*]" part, and
+// the test (op, value) is asked of each element; the atom is
+//   all(ranges[*] > 0.2)                    every element passes (true for none)
+//   any(objects[*].distance < 2)            some element passes (false for none)
+//   count(objects[*].distance < 2) >= 3     how many pass, compared with a number
+struct ArrayQuant {
+  enum class Kind : uint8_t { None, All, Any, Count };
+  Kind kind = Kind::None;
+  uint8_t count_op = 0;  // Count: a FieldTest::Op (Eq .. Ge) comparing the count
+  double count_value = 0;
+};
+const char* quant_name(ArrayQuant::Kind kind);  // "all"
 
 // A timing atom or a window aggregate (issue 26): not a field of the message
 // but what the runtime knows about an input's messages over time.
@@ -91,9 +107,11 @@ struct FieldTest {
   int column = 0;
   Timed timed;                    // kind None: an ordinary field test
   ExprPtr lhs, rhs;               // Timed::Kind::Expr: `lhs op rhs` (path is empty)
+  ArrayQuant quant;               // kind None: not an array quantifier
 
   bool is_timed() const { return timed.kind != Timed::Kind::None; }
   bool is_expr() const { return timed.kind == Timed::Kind::Expr; }
+  bool is_quantified() const { return quant.kind != ArrayQuant::Kind::None; }
   // The input a timing atom or aggregate is about ("" with one unnamed input).
   std::string timed_input() const;
   std::string key() const;        // path joined with '.'

@@ -492,6 +492,17 @@ class Parser {
   void parse_indexes(std::vector<std::string>& path) {
     while (peek() == '[') {
       const size_t open = pos_++;
+      if (peek() == '*') {  // every element: only inside an array quantifier
+        if (!in_quantifier_)
+          fail("'[*]' (every element) is written inside all(..), any(..) or count(..), e.g. {all(ranges[*] > 0.2)}",
+               open);
+        if (every_parts_++ > 0) fail("one '[*]' per quantifier: nested quantifiers are not supported", open);
+        ++pos_;
+        if (peek() != ']') fail("expected ']' after '[*'", pos_);
+        ++pos_;
+        path.push_back(kEveryElement);
+        continue;
+      }
       const size_t start = pos_;
       while (std::isdigit(static_cast<unsigned char>(peek()))) ++pos_;
       if (pos_ == start) fail("expected an array index (0, 1, ...) after '['", pos_);
@@ -539,6 +550,75 @@ class Parser {
     }
     return false;
   }
+
+  // ---- Array quantifiers (issue 29): all(a[*] > 0), any(..), count(..) >= 3 ----
+  // all( and any( always start one; count( only with a '[*]' inside its
+  // parentheses (else it is count(x), the aggregate over the whole past).
+  bool peek_array_quantifier(ArrayQuant::Kind& kind, size_t& length) const {
+    static constexpr std::pair<const char*, ArrayQuant::Kind> kWords[] = {
+        {"all", ArrayQuant::Kind::All}, {"any", ArrayQuant::Kind::Any}, {"count", ArrayQuant::Kind::Count}};
+    for (const auto& [word, k] : kWords) {
+      const size_t n = std::char_traits<char>::length(word);
+      if (s_.compare(pos_, n, word) != 0 || pos_ + n >= s_.size() || s_[pos_ + n] != '(') continue;
+      if (k == ArrayQuant::Kind::Count) {
+        int depth = 0;
+        bool every = false;
+        for (size_t i = pos_ + n; i < s_.size() && !every; ++i) {
+          const char c = s_[i];
+          if (c == '"') {  // a quoted key or string: skip it
+            for (++i; i < s_.size() && s_[i] != '"'; ++i)
+              if (s_[i] == '\\') ++i;
+          } else if (c == '(') {
+            ++depth;
+          } else if (c == ')') {
+            if (--depth == 0) break;
+          } else if (c == '}' || c == '{') {
+            break;
+          } else if (c == '[' && s_.compare(i, 3, kEveryElement) == 0) {
+            every = true;
+          }
+        }
+        if (!every) continue;
+      }
+      kind = k;
+      length = n;
+      return true;
+    }
+    return false;
+  }
+
+  FieldTest parse_array_quantifier(FieldTest t, ArrayQuant::Kind kind, size_t length) {
+    const std::string name = s_.substr(pos_, length);
+    if (in_quantifier_) fail("quantifiers do not nest: " + name + "(..) inside another", pos_);
+    pos_ += length + 1;  // the name and its '('
+    skip_ws();
+    const size_t inner_at = pos_;
+    in_quantifier_ = true;
+    every_parts_ = 0;
+    FieldTest element = parse_field_test();
+    in_quantifier_ = false;
+    using FOp = FieldTest::Op;
+    if (element.is_timed() || element.op == FOp::Present || element.op == FOp::Bind)
+      fail(name + "(..) tests each element of an array against a value, e.g. " + name +
+               "(ranges[*] > 0.2); this test is not one",
+           inner_at);
+    if (every_parts_ == 0)
+      fail(name + "(..) needs an array path with '[*]' (every element), e.g. " + name + "(ranges[*] > 0.2)", inner_at);
+    skip_ws();
+    if (peek() != ')') fail("expected ')' to close " + name + "(", pos_);
+    ++pos_;
+    element.column = t.column;
+    element.quant.kind = kind;
+    if (kind == ArrayQuant::Kind::Count) {
+      FieldTest cmp;
+      parse_number_comparison(cmp, "count(..)", "{count(objects[*].distance < 2) >= 3}");
+      element.quant.count_op = static_cast<uint8_t>(cmp.op);
+      element.quant.count_value = cmp.value.number;
+    }
+    return element;
+  }
+  bool in_quantifier_ = false;
+  int every_parts_ = 0;
 
   // A field path, or an input's timing atom as its last part: {@age ..},
   // {steer.@age ..}. Returns where the timing atom was written (npos: none).
@@ -615,6 +695,8 @@ class Parser {
     expr_nodes_ = 0;
     Timed::Func func;
     size_t length = 0;
+    ArrayQuant::Kind quant;
+    if (peek_array_quantifier(quant, length)) return parse_array_quantifier(std::move(t), quant, length);
     if (peek_aggregate(func, length) && !peek_function(pos_)) return parse_aggregate(std::move(t), func, length);
     if (starts_expression()) return finish_expression_test(std::move(t), parse_expr());
     const size_t path_at = pos_;
@@ -624,7 +706,7 @@ class Parser {
     if (is_arithmetic(peek())) return finish_expression_test(std::move(t), parse_expr(field_expr(t.path, path_at)));
     size_t op_at = pos_;
     using FOp = FieldTest::Op;
-    if (peek() == ',' || peek() == '}') { t.op = FOp::Truthy; return t; }
+    if (peek() == ',' || peek() == '}' || (in_quantifier_ && peek() == ')')) { t.op = FOp::Truthy; return t; }
     if (accept_symbol(":")) {
       skip_ws();
       if (peek() == '*') {
