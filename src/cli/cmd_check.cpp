@@ -17,6 +17,7 @@
 #include "cli/sync_options.hpp"
 #include "msg/type_registry.hpp"
 #include "runtime/check_stream.hpp"
+#include "runtime/instances_feed.hpp"
 #include "cli/bag_run.hpp"
 #include "runtime/check_bag.hpp"
 #include "transport/rosbag2/bag_reader.hpp"
@@ -51,6 +52,10 @@ struct CheckCommand {
   std::vector<std::string> msg_paths;  // --msg-path: definitions a bag's schemas leave out
   SyncFlags sync;                   // several topics
   msg::TypeRegistry registry;  // types from a bag's schemas
+  // --instances-by: one monitor instance per key value (docs/semantics.md, "Parametric instances")
+  std::string instances_by;
+  double instance_expiry = 0;
+  size_t max_instances = 100000;
 
   int run() {
     if (!store.take_database(outputs)) return kUsage;
@@ -69,6 +74,15 @@ struct CheckCommand {
     // A bag: named so (bag:PATH, mcap:PATH) or found by its content (an MCAP
     // or rosbag2 sqlite3 file, a folder with metadata.yaml), as `ros2 bag` takes it.
     const bool bag = input.rfind("mcap:", 0) == 0 || input.rfind("bag:", 0) == 0;
+    if (instances_by.empty() && (instance_expiry > 0 || max_instances != 100000)) {
+      std::fprintf(stderr, "rvc: --instance-expiry and --max-instances go with --instances-by FIELD\n");
+      return kUsage;
+    }
+    if (!instances_by.empty() && (bag || (path != "-" && transport::is_bag(path)) || check.calls)) {
+      std::fprintf(stderr, "rvc: --instances-by routes a JSON-lines trace's messages by a field; it does not "
+                           "take a bag, --calls or synchronized inputs\n");
+      return kUsage;
+    }
     if (bag || (path != "-" && transport::is_bag(path)))
       return run_bag(properties, bag ? input.substr(input.find(':') + 1) : path, opath);
     if (path != "-")
@@ -106,6 +120,7 @@ struct CheckCommand {
     if (!store.database.empty()) runtime::check_specs(properties, check.dense);
     auto results = store.open();
     if (results) results->attach(input, popts, outputs);
+    if (!instances_by.empty()) return run_instances(properties, popts, outputs, results.get(), fd, path);
     runtime::Pipeline pipeline(properties, popts, [&](const engine::Verdict& v) { outputs.put(v); });
     if (results) results->start(runtime::run_info(command_line(), {input}, properties, check.dense));
     io::ReaderOptions ropts;
@@ -137,6 +152,64 @@ struct CheckCommand {
     if (results)
       results->finish(outcome, stopped ? "signal" : "end of input",
                       counters_json(pipeline.stats(), pipeline.violations()));
+    return outcome.exit_code();
+  }
+
+  // --instances-by: one Pipeline per key value behind one reader (runtime/instances_feed.hpp).
+  int run_instances(const std::vector<engine::PropertySpec>& properties, const runtime::PipelineOptions& popts,
+                    runtime::VerdictOutputs& outputs, runtime::ResultsOutput* results, int fd, const std::string& path) {
+    runtime::InstanceOptions iopts;
+    for (size_t start = 0;;) {
+      const size_t dot = instances_by.find('.', start);
+      iopts.key_path.push_back(instances_by.substr(start, dot == std::string::npos ? std::string::npos : dot - start));
+      if (iopts.key_path.back().empty()) {
+        std::fprintf(stderr, "rvc: --instances-by '%s': an empty field name (write a field path like vehicle.id)\n",
+                     instances_by.c_str());
+        return kUsage;
+      }
+      if (dot == std::string::npos) break;
+      start = dot + 1;
+    }
+    iopts.expiry = instance_expiry;
+    iopts.max_instances = max_instances;
+    runtime::InstancesFeed feed(properties, popts, outputs, iopts);
+    if (results) results->start(runtime::run_info(command_line(), {input}, properties, check.dense));
+    io::ReaderOptions ropts;
+    ropts.max_line_bytes = check.max_message_size;
+    install_stop_signals();
+    end_input_on_stop(fd);
+    const bool live = path == "-", tick = clock.ticks_at_end(check.dense);
+    if (live) ropts.after_chunk = [&outputs] { outputs.idle(); };
+    runtime::Outcome outcome = runtime::run_check(feed, outputs, [&](runtime::Outcome& o) {
+      std::string error;
+      if (!io::read_jsonl(fd, feed, ropts, error)) {
+        std::fprintf(stderr, "rvc: error: %s\n", error.c_str());
+        o.runtime_failure = true;
+        return;
+      }
+      if (tick) feed.tick_each_at_end();
+    });
+    end_input_on_stop(-1);
+    if (fd != 0) ::close(fd);
+    report(feed.stats(), feed.violations());
+    if (feed.lost() > 0)
+      std::fprintf(stderr, "rvc: %llu messages dropped: --max-instances %zu refused %llu new keys\n",
+                   static_cast<unsigned long long>(feed.lost()), max_instances,
+                   static_cast<unsigned long long>(feed.refused_keys()));
+    const bool stopped = stop_requested();
+    if (stopped) {
+      std::fprintf(stderr, "rvc: stopped by a signal: %s was not read to its end\n", live ? "stdin" : path.c_str());
+      outcome.incomplete = true;
+    }
+    if (stats) {
+      io::JsonObject counters;
+      counters.add("input", input);
+      runtime::add_run_counters(counters, feed, outputs.count());
+      feed.add_stats(counters);
+      std::fprintf(stderr, "%s\n", counters.str().c_str());
+    }
+    if (results)
+      results->finish(outcome, stopped ? "signal" : "end of input", counters_json(feed.stats(), feed.violations()));
     return outcome.exit_code();
   }
 
@@ -212,6 +285,17 @@ Runner register_check(CLI::App& app) {
                   "Foxglove, docs/mcap-output.md); repeatable for results databases: "
                   "sqlite:PATH or postgresql://... (docs/results.md)");
   cmd->store.add_to(*sub);
+  sub->add_option("--instances-by", cmd->instances_by,
+                  "One monitor instance per value of this field (a path: id, vehicle.id); each verdict carries "
+                  "\"instance\":{\"FIELD\":VALUE} (docs/semantics.md, \"Parametric instances\")");
+  sub->add_option("--instance-expiry", cmd->instance_expiry,
+                  "With --instances-by: remove an instance whose last message is more than SECONDS (stream time; "
+                  "messages for a trace without times) before the message being routed; its key then starts afresh")
+      ->check(CLI::PositiveNumber);
+  sub->add_option("--max-instances", cmd->max_instances,
+                  "With --instances-by: the most live instances (default 100000); messages of further keys are "
+                  "dropped (\"instance_limit\", exit 3)")
+      ->check(CLI::PositiveNumber);
   sub->add_flag("--summary", cmd->summary, "Print message counts to stderr at the end");
   sub->add_flag("--stats", cmd->stats,
                 "Print the counters as one JSON line on stderr at the end (received, checked, rejected, dropped by "
