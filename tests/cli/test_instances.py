@@ -153,3 +153,17 @@ def test_instance_options_need_instances_by(rvc, tmp_path):
     trace = write(tmp_path / "t.jsonl", [{"ok": True}])
     r = run(rvc, "check", "--instance-expiry", "3", "--spec", "{ok}", trace)
     assert r.returncode == 2 and "--instances-by" in r.stderr
+
+
+def test_results_database_keeps_instances_apart(rvc, tmp_path):
+    import sqlite3
+    trace = write(tmp_path / "t.jsonl", [{"id": "a", "ok": True}, {"id": "b", "ok": False},
+                                         {"id": "a", "ok": False}, {"id": "b", "ok": False}])
+    db = tmp_path / "r.db"
+    r = run(rvc, "check", "--instances-by", "id", "--spec", "{ok}", "-o", f"sqlite:{db}", trace)
+    assert r.returncode == 1, r.stderr
+    rows = sqlite3.connect(db).execute("SELECT property, time, value FROM verdicts ORDER BY id").fetchall()
+    # a verdict change per instance: b's second false is no change for b (though a turned false between)
+    assert rows == [('p1 {"id":"a"}', 0, 1), ('p1 {"id":"b"}', 0, 0), ('p1 {"id":"a"}', 1, 0)]
+    viol = sqlite3.connect(db).execute("SELECT property FROM violations ORDER BY id").fetchall()
+    assert viol == [('p1 {"id":"b"}',), ('p1 {"id":"a"}',)]
