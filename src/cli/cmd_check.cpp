@@ -8,6 +8,7 @@
 #include <memory>
 
 #include "cli/check_options.hpp"
+#include "cli/instance_options.hpp"
 #include "cli/clock_options.hpp"
 #include "cli/commands.hpp"
 #include "cli/output_sinks.hpp"
@@ -52,10 +53,8 @@ struct CheckCommand {
   std::vector<std::string> msg_paths;  // --msg-path: definitions a bag's schemas leave out
   SyncFlags sync;                   // several topics
   msg::TypeRegistry registry;  // types from a bag's schemas
-  // --instances-by: one monitor instance per key value (docs/semantics.md, "Parametric instances")
-  std::string instances_by;
-  double instance_expiry = 0;
-  size_t max_instances = 100000;
+  InstanceFlags instances;  // --instances-by: one monitor instance per key value (docs/semantics.md)
+  runtime::InstanceOptions iopts;
 
   int run() {
     if (!store.take_database(outputs)) return kUsage;
@@ -74,11 +73,8 @@ struct CheckCommand {
     // A bag: named so (bag:PATH, mcap:PATH) or found by its content (an MCAP
     // or rosbag2 sqlite3 file, a folder with metadata.yaml), as `ros2 bag` takes it.
     const bool bag = input.rfind("mcap:", 0) == 0 || input.rfind("bag:", 0) == 0;
-    if (instances_by.empty() && (instance_expiry > 0 || max_instances != 100000)) {
-      std::fprintf(stderr, "rvc: --instance-expiry and --max-instances go with --instances-by FIELD\n");
-      return kUsage;
-    }
-    if (!instances_by.empty() && (bag || (path != "-" && transport::is_bag(path)) || check.calls)) {
+    if (!instances.options(iopts)) return kUsage;
+    if (instances.given() && (bag || (path != "-" && transport::is_bag(path)) || check.calls)) {
       std::fprintf(stderr, "rvc: --instances-by routes a JSON-lines trace's messages by a field; it does not "
                            "take a bag, --calls or synchronized inputs\n");
       return kUsage;
@@ -120,7 +116,7 @@ struct CheckCommand {
     if (!store.database.empty()) runtime::check_specs(properties, check.dense);
     auto results = store.open();
     if (results) results->attach(input, popts, outputs);
-    if (!instances_by.empty()) return run_instances(properties, popts, outputs, results.get(), fd, path);
+    if (instances.given()) return run_instances(properties, popts, outputs, results.get(), fd, path);
     runtime::Pipeline pipeline(properties, popts, [&](const engine::Verdict& v) { outputs.put(v); });
     if (results) results->start(runtime::run_info(command_line(), {input}, properties, check.dense));
     io::ReaderOptions ropts;
@@ -158,20 +154,6 @@ struct CheckCommand {
   // --instances-by: one Pipeline per key value behind one reader (runtime/instances_feed.hpp).
   int run_instances(const std::vector<engine::PropertySpec>& properties, const runtime::PipelineOptions& popts,
                     runtime::VerdictOutputs& outputs, runtime::ResultsOutput* results, int fd, const std::string& path) {
-    runtime::InstanceOptions iopts;
-    for (size_t start = 0;;) {
-      const size_t dot = instances_by.find('.', start);
-      iopts.key_path.push_back(instances_by.substr(start, dot == std::string::npos ? std::string::npos : dot - start));
-      if (iopts.key_path.back().empty()) {
-        std::fprintf(stderr, "rvc: --instances-by '%s': an empty field name (write a field path like vehicle.id)\n",
-                     instances_by.c_str());
-        return kUsage;
-      }
-      if (dot == std::string::npos) break;
-      start = dot + 1;
-    }
-    iopts.expiry = instance_expiry;
-    iopts.max_instances = max_instances;
     runtime::InstancesFeed feed(properties, popts, outputs, iopts);
     if (results) results->start(runtime::run_info(command_line(), {input}, properties, check.dense));
     io::ReaderOptions ropts;
@@ -194,7 +176,7 @@ struct CheckCommand {
     report(feed.stats(), feed.violations());
     if (feed.lost() > 0)
       std::fprintf(stderr, "rvc: %llu messages dropped: --max-instances %zu refused %llu new keys\n",
-                   static_cast<unsigned long long>(feed.lost()), max_instances,
+                   static_cast<unsigned long long>(feed.lost()), iopts.max_instances,
                    static_cast<unsigned long long>(feed.refused_keys()));
     const bool stopped = stop_requested();
     if (stopped) {
@@ -285,17 +267,7 @@ Runner register_check(CLI::App& app) {
                   "Foxglove, docs/mcap-output.md); repeatable for results databases: "
                   "sqlite:PATH or postgresql://... (docs/results.md)");
   cmd->store.add_to(*sub);
-  sub->add_option("--instances-by", cmd->instances_by,
-                  "One monitor instance per value of this field (a path: id, vehicle.id); each verdict carries "
-                  "\"instance\":{\"FIELD\":VALUE} (docs/semantics.md, \"Parametric instances\")");
-  sub->add_option("--instance-expiry", cmd->instance_expiry,
-                  "With --instances-by: remove an instance whose last message is more than SECONDS (stream time; "
-                  "messages for a trace without times) before the message being routed; its key then starts afresh")
-      ->check(CLI::PositiveNumber);
-  sub->add_option("--max-instances", cmd->max_instances,
-                  "With --instances-by: the most live instances (default 100000); messages of further keys are "
-                  "dropped (\"instance_limit\", exit 3)")
-      ->check(CLI::PositiveNumber);
+  cmd->instances.add_to(*sub);
   sub->add_flag("--summary", cmd->summary, "Print message counts to stderr at the end");
   sub->add_flag("--stats", cmd->stats,
                 "Print the counters as one JSON line on stderr at the end (received, checked, rejected, dropped by "

@@ -167,3 +167,15 @@ def test_results_database_keeps_instances_apart(rvc, tmp_path):
     assert rows == [('p1 {"id":"a"}', 0, 1), ('p1 {"id":"b"}', 0, 0), ('p1 {"id":"a"}', 1, 0)]
     viol = sqlite3.connect(db).execute("SELECT property FROM violations ORDER BY id").fetchall()
     assert viol == [('p1 {"id":"b"}',), ('p1 {"id":"a"}',)]
+
+
+def test_monitor_file_input_equals_check(rvc, tmp_path):
+    msgs = fleet_trace(11, n=200, keys=4)
+    trace = write(tmp_path / "fleet.jsonl", msgs)
+    args = [a for s in SPECS for a in ("--spec", s)]
+    want = run(rvc, "check", "--instances-by", "id", *args, trace)
+    out = tmp_path / "out.jsonl"
+    r = run(rvc, "monitor", "--instances-by", "id", *args, "-i", f"file:{trace}", "-o", f"file:{out}")
+    assert r.returncode == want.returncode, r.stderr
+    got = [l for l in out.read_text().splitlines() if '"instance"' in l]
+    assert got and got == want.stdout.splitlines()
