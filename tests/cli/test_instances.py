@@ -73,11 +73,12 @@ def fleet_trace(seed, n=400, keys=6):
     for _ in range(n):
         t += rnd.choice([0.1, 0.25, 0.5])
         out.append({"time": round(t, 3), "id": f"v{rnd.randrange(keys)}", "speed": rnd.randrange(0, 40),
-                    "brake": rnd.random() < 0.3})
+                    "brake": rnd.random() < 0.3, "gear": rnd.randrange(1, 4)})
     return out
 
 
-SPECS = ["historically({speed > 30} -> once[0:1]{brake})", "{brake} since {speed < 10}"]
+SPECS = ["historically({speed > 30} -> once[0:1]{brake})", "{brake} since {speed < 10}",
+         "forall[g]. ({gear: *g} -> once[1:2]{gear: *g})"]  # data references run inside each instance
 
 
 @pytest.mark.parametrize("mode", [[], ["--all"], ["--dense"], ["--dense", "--all"]])
@@ -179,3 +180,15 @@ def test_monitor_file_input_equals_check(rvc, tmp_path):
     assert r.returncode == want.returncode, r.stderr
     got = [l for l in out.read_text().splitlines() if '"instance"' in l]
     assert got and got == want.stdout.splitlines()
+
+
+def test_max_data_values_is_per_instance(rvc, tmp_path):
+    # each key binds two distinct gears: within --max-data-values 2 per instance, though the run has 4
+    msgs = [{"id": k, "gear": g} for k, gs in (("a", (1, 2)), ("b", (3, 4))) for g in gs]
+    trace = write(tmp_path / "t.jsonl", msgs)
+    spec = ["--spec", "exists[g]. {gear: *g}", "--max-data-values", "2"]
+    assert run(rvc, "check", "--instances-by", "id", *spec, trace).returncode == 0
+    assert run(rvc, "check", *spec, trace).returncode == 5  # one stream: 4 values
+    trace = write(tmp_path / "t3.jsonl", msgs + [{"id": "a", "gear": 9}])
+    r = run(rvc, "check", "--instances-by", "id", *spec, trace)
+    assert r.returncode == 5, r.stderr  # instance a's third value: the run stops, as without instances
