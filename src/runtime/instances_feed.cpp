@@ -104,7 +104,9 @@ io::ReadResult InstancesFeed::on_object(const io::Position& where, simdjson::ond
   }
   if (!pending_rejection_.empty()) return io::ReadResult::Pending;  // counted at commit() (it may be broken)
   if (instance_options_.expiry > 0) expire_before(now, ordinal_, !std::isnan(now));
+  const uint64_t created_before = created_;
   current_ = instance_for(key, key_json);
+  current_fresh_ = created_ != created_before;
   if (!current_) {
     pending_rejection_.clear();
     return io::ReadResult::Pending;  // dropped at commit(): the limit
@@ -113,7 +115,7 @@ io::ReadResult InstancesFeed::on_object(const io::Position& where, simdjson::ond
   current_->last_ordinal = ordinal_;
   lru_.splice(lru_.end(), lru_, current_->lru);
   io::ReadResult result = current_->pipeline->on_object(where, object);
-  if (result != io::ReadResult::Pending) current_ = nullptr;
+  if (result != io::ReadResult::Pending) drop_fresh();  // broken JSON: the reader reports it to us
   return result;
 }
 
@@ -195,8 +197,20 @@ void InstancesFeed::commit() {
 
 void InstancesFeed::discard() {
   if (current_) current_->pipeline->discard();
-  current_ = nullptr;
+  drop_fresh();
   pending_rejection_.clear();
+}
+
+// The pending message made its instance and turned out broken: no instance
+// was started by it (a key seen only on broken lines makes none).
+void InstancesFeed::drop_fresh() {
+  if (current_ && current_fresh_) {
+    --created_;
+    lru_.erase(current_->lru);
+    instances_.erase(current_->key);
+  }
+  current_ = nullptr;
+  current_fresh_ = false;
 }
 
 void InstancesFeed::on_error(const io::LineError& error) {

@@ -81,6 +81,7 @@ class InstancesFeed final : public io::JsonlHandler, public Feed {
   Instance* instance_for(const std::string& key, const std::string& key_json);
   void expire_before(double now, uint64_t ordinal, bool has_time);
   void retire(Instance& instance);
+  void drop_fresh();
   void report(const std::string& text);
 
   std::vector<engine::PropertySpec> properties_;
@@ -91,6 +92,7 @@ class InstancesFeed final : public io::JsonlHandler, public Feed {
   std::unordered_map<std::string, std::unique_ptr<Instance>> instances_;
   std::list<Instance*> lru_;  // least recently fed first
   Instance* current_ = nullptr;  // the pending message's instance
+  bool current_fresh_ = false;   // ... made by that message
   std::string pending_rejection_;
   uint64_t pending_line_ = 0;
   uint64_t ordinal_ = 0;

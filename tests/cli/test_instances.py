@@ -192,3 +192,17 @@ def test_max_data_values_is_per_instance(rvc, tmp_path):
     trace = write(tmp_path / "t3.jsonl", msgs + [{"id": "a", "gear": 9}])
     r = run(rvc, "check", "--instances-by", "id", *spec, trace)
     assert r.returncode == 5, r.stderr  # instance a's third value: the run stops, as without instances
+
+
+def test_broken_lines_are_rejected_as_without_instances(rvc, tmp_path):
+    p = tmp_path / "bad.jsonl"
+    p.write_text('{"id":"a","ok":true}\n{"id":"a","ok":tru\n{"id":"c","ok":false}{"id":"d"}\nnot json\n'
+                 '{"ok":true,"id":"b"}\n')
+    r = run(rvc, "check", "--stats", "--instances-by", "id", "--spec", "{ok}", str(p))
+    plain_run = run(rvc, "check", "--stats", "--spec", "{ok}", str(p))
+    c, c0 = counters(r.stderr), counters(plain_run.stderr)
+    assert (c["checked"], c["rejected"]) == (c0["checked"], c0["rejected"]) == (2, 3)
+    # the same errors, by line; key "c" came only on a broken line: no instance for it
+    assert [l for l in r.stderr.splitlines() if "skipped" in l] == \
+           [l for l in plain_run.stderr.splitlines() if "skipped" in l]
+    assert c["instances"]["created"] == 2 and set(by_instance(r.stdout)) == {"a", "b"}
