@@ -274,7 +274,7 @@ Runner register_check(CLI::App& app) {
                 "reason, warnings, verdicts, violations), as rvc monitor does");
   sub->footer(
       "Exit status: 0 all properties held, 1 a property was violated, 2 usage or spec error, 3 messages were\n"
-      "rejected (or dropped as late), 5 runtime failure (the trace could not be read, verdicts or results could\n"
+      "rejected (or dropped: late, --max-instances), 5 runtime failure (the trace could not be read, verdicts or results could\n"
       "not be written), 6 nothing was checked (an empty trace, every message rejected or unmatched) or stopped\n"
       "by SIGINT/SIGTERM before the end of the trace (what was read is checked and stored).\n"
       "Example: rvc check --spec 'historically({emergency} -> once[0:1]{hazard_lights})' trace.jsonl");
