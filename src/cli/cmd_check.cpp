@@ -8,6 +8,7 @@
 #include <memory>
 
 #include "cli/check_options.hpp"
+#include "cli/instance_options.hpp"
 #include "cli/clock_options.hpp"
 #include "cli/commands.hpp"
 #include "cli/output_sinks.hpp"
@@ -17,6 +18,7 @@
 #include "cli/sync_options.hpp"
 #include "msg/type_registry.hpp"
 #include "runtime/check_stream.hpp"
+#include "runtime/instances_feed.hpp"
 #include "cli/bag_run.hpp"
 #include "runtime/check_bag.hpp"
 #include "transport/rosbag2/bag_reader.hpp"
@@ -51,6 +53,8 @@ struct CheckCommand {
   std::vector<std::string> msg_paths;  // --msg-path: definitions a bag's schemas leave out
   SyncFlags sync;                   // several topics
   msg::TypeRegistry registry;  // types from a bag's schemas
+  InstanceFlags instances;  // --instances-by: one monitor instance per key value (docs/semantics.md)
+  runtime::InstanceOptions iopts;
 
   int run() {
     if (!store.take_database(outputs)) return kUsage;
@@ -69,6 +73,12 @@ struct CheckCommand {
     // A bag: named so (bag:PATH, mcap:PATH) or found by its content (an MCAP
     // or rosbag2 sqlite3 file, a folder with metadata.yaml), as `ros2 bag` takes it.
     const bool bag = input.rfind("mcap:", 0) == 0 || input.rfind("bag:", 0) == 0;
+    if (!instances.options(iopts)) return kUsage;
+    if (instances.given() && (bag || (path != "-" && transport::is_bag(path)) || check.calls)) {
+      std::fprintf(stderr, "rvc: --instances-by routes a JSON-lines trace's messages by a field; it does not "
+                           "take a bag, --calls or synchronized inputs\n");
+      return kUsage;
+    }
     if (bag || (path != "-" && transport::is_bag(path)))
       return run_bag(properties, bag ? input.substr(input.find(':') + 1) : path, opath);
     if (path != "-")
@@ -106,6 +116,7 @@ struct CheckCommand {
     if (!store.database.empty()) runtime::check_specs(properties, check.dense);
     auto results = store.open();
     if (results) results->attach(input, popts, outputs);
+    if (instances.given()) return run_instances(properties, popts, outputs, results.get(), fd, path);
     runtime::Pipeline pipeline(properties, popts, [&](const engine::Verdict& v) { outputs.put(v); });
     if (results) results->start(runtime::run_info(command_line(), {input}, properties, check.dense));
     io::ReaderOptions ropts;
@@ -137,6 +148,50 @@ struct CheckCommand {
     if (results)
       results->finish(outcome, stopped ? "signal" : "end of input",
                       counters_json(pipeline.stats(), pipeline.violations()));
+    return outcome.exit_code();
+  }
+
+  // --instances-by: one Pipeline per key value behind one reader (runtime/instances_feed.hpp).
+  int run_instances(const std::vector<engine::PropertySpec>& properties, const runtime::PipelineOptions& popts,
+                    runtime::VerdictOutputs& outputs, runtime::ResultsOutput* results, int fd, const std::string& path) {
+    runtime::InstancesFeed feed(properties, popts, outputs, iopts);
+    if (results) results->start(runtime::run_info(command_line(), {input}, properties, check.dense));
+    io::ReaderOptions ropts;
+    ropts.max_line_bytes = check.max_message_size;
+    install_stop_signals();
+    end_input_on_stop(fd);
+    const bool live = path == "-", tick = clock.ticks_at_end(check.dense);
+    if (live) ropts.after_chunk = [&outputs] { outputs.idle(); };
+    runtime::Outcome outcome = runtime::run_check(feed, outputs, [&](runtime::Outcome& o) {
+      std::string error;
+      if (!io::read_jsonl(fd, feed, ropts, error)) {
+        std::fprintf(stderr, "rvc: error: %s\n", error.c_str());
+        o.runtime_failure = true;
+        return;
+      }
+      if (tick) feed.tick_each_at_end();
+    });
+    end_input_on_stop(-1);
+    if (fd != 0) ::close(fd);
+    report(feed.stats(), feed.violations());
+    if (feed.lost() > 0)
+      std::fprintf(stderr, "rvc: %llu messages dropped: --max-instances %zu refused %llu new keys\n",
+                   static_cast<unsigned long long>(feed.lost()), iopts.max_instances,
+                   static_cast<unsigned long long>(feed.refused_keys()));
+    const bool stopped = stop_requested();
+    if (stopped) {
+      std::fprintf(stderr, "rvc: stopped by a signal: %s was not read to its end\n", live ? "stdin" : path.c_str());
+      outcome.incomplete = true;
+    }
+    if (stats) {
+      io::JsonObject counters;
+      counters.add("input", input);
+      runtime::add_run_counters(counters, feed, outputs.count());
+      feed.add_stats(counters);
+      std::fprintf(stderr, "%s\n", counters.str().c_str());
+    }
+    if (results)
+      results->finish(outcome, stopped ? "signal" : "end of input", counters_json(feed.stats(), feed.violations()));
     return outcome.exit_code();
   }
 
@@ -212,13 +267,14 @@ Runner register_check(CLI::App& app) {
                   "Foxglove, docs/mcap-output.md); repeatable for results databases: "
                   "sqlite:PATH or postgresql://... (docs/results.md)");
   cmd->store.add_to(*sub);
+  cmd->instances.add_to(*sub);
   sub->add_flag("--summary", cmd->summary, "Print message counts to stderr at the end");
   sub->add_flag("--stats", cmd->stats,
                 "Print the counters as one JSON line on stderr at the end (received, checked, rejected, dropped by "
                 "reason, warnings, verdicts, violations), as rvc monitor does");
   sub->footer(
       "Exit status: 0 all properties held, 1 a property was violated, 2 usage or spec error, 3 messages were\n"
-      "rejected (or dropped as late), 5 runtime failure (the trace could not be read, verdicts or results could\n"
+      "rejected (or dropped: late, --max-instances), 5 runtime failure (the trace could not be read, verdicts or results could\n"
       "not be written), 6 nothing was checked (an empty trace, every message rejected or unmatched) or stopped\n"
       "by SIGINT/SIGTERM before the end of the trace (what was read is checked and stored).\n"
       "Example: rvc check --spec 'historically({emergency} -> once[0:1]{hazard_lights})' trace.jsonl");

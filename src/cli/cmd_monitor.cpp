@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "cli/instance_options.hpp"
 #include "cli/check_options.hpp"
 #include "cli/clock_options.hpp"
 #include "cli/option_ranges.hpp"
@@ -72,6 +73,8 @@ struct MonitorCommand {
   std::shared_ptr<void> liveliness_token;  // rvc/monitors/<name> while the monitor runs
   GroupFlags group;                        // --group, --shard-by: one replica of a monitor group
   std::unique_ptr<runtime::fleet::ShardedFeed> sharded;
+  InstanceFlags instances;  // --instances-by: one monitor instance per key value (docs/semantics.md)
+  runtime::InstanceOptions iopts;
 
   // --group: refuses what a replica cannot do, then joins (token, member set).
   int join_group(const std::vector<std::string>& uris) {
@@ -534,6 +537,13 @@ struct MonitorCommand {
     if (!store.take_database(outputs)) return kUsage;
     if (outputs.empty()) outputs.push_back("-");
     const bool bag = !SyncFlags::named(inputs) && is_bag_input(inputs.at(0));
+    if (!instances.options(iopts)) return kUsage;
+    if (instances.given() && (bag || SyncFlags::named(inputs) || check.calls || typed.given() || group.given() ||
+                              !forward_property.empty() || (clock.clock != "auto" && clock.clock != "off"))) {
+      std::fprintf(stderr, "rvc: --instances-by routes one JSON input's messages by a field; it does not take a bag, "
+                           "several inputs, --calls, --type, --group, --forward or --clock (instances move with their own messages)\n");
+      return kUsage;
+    }
     if (!bag)
       if (int status = refuse_input_copies(outputs, inputs.at(0))) return status;
     if (SyncFlags::named(inputs)) return run_synced();
@@ -594,6 +604,8 @@ struct MonitorCommand {
     }
     attach_results(input, popts, verdicts);
     runtime::Pipeline pipeline(properties, popts, [&](const engine::Verdict& v) { verdicts.put(v); });
+    std::unique_ptr<runtime::InstancesFeed> instance_feed;
+    if (instances.given()) instance_feed = std::make_unique<runtime::InstancesFeed>(properties, popts, verdicts, iopts);
     std::unique_ptr<runtime::ServiceCallFeed> call_feed;
     if (check.calls)
       call_feed = std::make_unique<runtime::ServiceCallFeed>(pipeline, event_type, check.service_timeout,
@@ -626,6 +638,7 @@ struct MonitorCommand {
           },
           verdicts);
     runtime::Feed& feed = sharded     ? static_cast<runtime::Feed&>(*sharded)
+                          : instance_feed ? static_cast<runtime::Feed&>(*instance_feed)
                           : forwarder ? static_cast<runtime::Feed&>(*forwarder)
                           : call_feed ? static_cast<runtime::Feed&>(*call_feed)
                                       : pipeline;
@@ -668,6 +681,7 @@ Runner register_monitor(CLI::App& app) {
   cmd->store.add_to(*sub);
   cmd->health.add_to(*sub);
   cmd->group.add_to(*sub);
+  cmd->instances.add_to(*sub);
   sub->add_option("--allow", cmd->filter_options.allow,
                   "Filter (repeatable): only messages whose key (a zenoh: sample's own key) or topic matches one of "
                   "these patterns reach the monitor; '*' one chunk, '**' any chunks (docs/filter.md)");

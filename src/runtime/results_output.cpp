@@ -15,7 +15,17 @@ void ResultsOutput::attach(const std::string& input_name, PipelineOptions& optio
   options.on_message = [store](std::string_view input, std::string_view text, uint64_t position) {
     store->on_message(input, text, position);
   };
-  outputs.observe([store](const engine::Verdict& v) { store->on_verdict(v.property, v.time, v.value, v.explanation, v.known_at);
+  VerdictOutputs* out = &outputs;
+  outputs.observe([store, out](const engine::Verdict& v) {
+    // A parametric instance's verdict (--instances-by; mark ,"instance":{..}):
+    // stored under "NAME {..}", so each instance has its own verdict changes.
+    constexpr std::string_view kInstance = ",\"instance\":";
+    if (const std::string_view m = out->mark(); m.rfind(kInstance, 0) == 0) {
+      const std::string name = v.property + " " + std::string(m.substr(kInstance.size()));
+      store->on_verdict(name, v.time, v.value, v.explanation, v.known_at);
+      return;
+    }
+    store->on_verdict(v.property, v.time, v.value, v.explanation, v.known_at);
   });
 }
 

@@ -73,6 +73,7 @@ class VerdictOutputs {
   // Extra JSON members for the verdicts put until the next call (",\"handover\":true"
   // while a group replica replays a shard it took over); "" for none. JSON sinks only.
   void set_mark(std::string_view members) { mark_ = members; }
+  std::string_view mark() const { return mark_; }
 
   uint64_t count() const { return count_; }
   size_t size() const { return sinks_.size(); }

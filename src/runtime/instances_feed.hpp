@@ -1,0 +1,110 @@
+// Parametric instances (`rvc check --instances-by id`, docs/semantics.md
+// "Parametric instances"): one monitor instance (a Pipeline, the same a
+// single-object check would run) per value of a key field, created on the
+// key's first message; each instance's verdicts carry
+// "instance":{"<key>":<value>}.
+//
+// One parse per message: the JSON-lines reader hands each line's simdjson
+// object here; the key (and the time field, for expiry) are looked up in it,
+// the object is reset and handed on to the instance's Pipeline, which decodes
+// it as it would unrouted. The layout fast path is off (it reads lines
+// without simdjson, for one Pipeline).
+//
+// Counts: received = checked + rejected + dropped. A message without the
+// key (or with a key that is no string or number) is rejected ("no key");
+// with --max-instances N, a message whose key would make instance N+1 is
+// dropped ("instance_limit": exit 3, the run goes on). --instance-expiry S
+// removes an instance whose last message is more than S (stream time)
+// before the message being routed; the key's next message starts a fresh
+// instance (steps and history from zero).
+#pragma once
+
+#include <cstdint>
+#include <list>
+#include <memory>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "runtime/pipeline.hpp"
+#include "runtime/verdict_outputs.hpp"
+
+namespace rvc::runtime {
+
+struct InstanceOptions {
+  std::vector<std::string> key_path;  // "vehicle.id" -> {"vehicle", "id"}
+  double expiry = 0;                  // seconds of stream time (<= 0: never)
+  size_t max_instances = 100000;      // live instances at once
+};
+
+class InstancesFeed final : public io::JsonlHandler, public Feed {
+ public:
+  // Throws spec::SpecError for a bad spec (an instance is built once here to check).
+  InstancesFeed(const std::vector<engine::PropertySpec>& properties, const PipelineOptions& options,
+                VerdictOutputs& outputs, InstanceOptions instance_options);
+  ~InstancesFeed() override;
+
+  // JsonlHandler
+  io::ReadResult on_object(const io::Position& position, simdjson::ondemand::object object) override;
+  std::string json_error() const override { return json_error_; }
+  void commit() override;
+  void discard() override;
+  void on_error(const io::LineError& error) override;
+  void on_warning(const io::LineError& warning) override;
+
+  // Feed (a network payload: its lines read as a file's)
+  void feed_input(uint32_t input, std::string_view payload, uint64_t position) override;
+  void warn(const io::LineError& warning) override { on_warning(warning); }
+  uint64_t received() const override;
+  void add_dropped(io::JsonObject& out) const override;
+  uint64_t lost() const override { return limit_dropped_; }
+  const PipelineStats& stats() const override;
+  uint64_t violations() const override;
+  void finish_report() override;
+  // "instances": {"created", "expired", "live", "refused_keys"}
+  void add_stats(io::JsonObject& out) const override;
+  double last_stamp() const override { return last_stamp_; }
+  // Dense time, --clock auto: each instance ticks at its own last stamp (its
+  // last message's segment gets its verdict, as in a check of its sub-trace).
+  void tick_each_at_end();
+  uint64_t refused_keys() const { return refused_keys_; }
+
+ private:
+  struct Instance {
+    std::string key;
+    std::string mark;  // ,"instance":{...}: the members its verdicts get
+    std::unique_ptr<Pipeline> pipeline;
+    double last_time = std::numeric_limits<double>::quiet_NaN();
+    uint64_t last_ordinal = 0;
+    std::list<Instance*>::iterator lru;
+  };
+  Instance* instance_for(const std::string& key, const std::string& key_json);
+  void expire_before(double now, uint64_t ordinal, bool has_time);
+  void retire(Instance& instance);
+  void drop_fresh();
+  void report(const std::string& text);
+
+  std::vector<engine::PropertySpec> properties_;
+  PipelineOptions options_;
+  VerdictOutputs& outputs_;
+  InstanceOptions instance_options_;
+  std::string key_name_;  // the path as written ("vehicle.id"): the instance object's member name
+  std::unordered_map<std::string, std::unique_ptr<Instance>> instances_;
+  std::list<Instance*> lru_;  // least recently fed first
+  Instance* current_ = nullptr;  // the pending message's instance
+  bool current_fresh_ = false;   // ... made by that message
+  std::string pending_rejection_;
+  uint64_t pending_line_ = 0;
+  uint64_t ordinal_ = 0;
+  PipelineStats retired_;
+  uint64_t retired_violations_ = 0;
+  uint64_t own_rejected_ = 0, own_warnings_ = 0, limit_dropped_ = 0;
+  uint64_t created_ = 0, expired_ = 0, refused_keys_ = 0;
+  uint64_t reported_ = 0;
+  double last_stamp_ = std::numeric_limits<double>::quiet_NaN();
+  std::string json_error_;
+  std::unordered_map<std::string, bool> refused_;  // keys refused by the limit (counted once each)
+  mutable PipelineStats stats_;
+};
+
+}  // namespace rvc::runtime
