@@ -168,7 +168,9 @@ void ShardedFeed::follow_members() {
 }
 
 void ShardedFeed::take(Shard& s, std::chrono::steady_clock::time_point changed_at) {
-  s.instance = factory_(s.key, [this](const engine::Verdict& v) { on_verdict(v); });
+  const Shard* shard = &s;  // shards_ holds each Shard behind a unique_ptr: the address stays
+  s.instance = factory_(s.key, [this, shard](const engine::Verdict& v) { on_verdict(*shard, v); });
+  s.partial = s.evicted;
   if (s.evicted) {
     // Bounded properties are rebuilt from the last window; what depends on
     // older messages (unbounded operators, discrete step numbers) may differ.
@@ -222,19 +224,26 @@ void ShardedFeed::release(Shard& s) {
   s.evicted = true;  // the window restarts here: taken back, it replays from now on only
 }
 
-void ShardedFeed::on_verdict(const engine::Verdict& v) {
+void ShardedFeed::on_verdict(const Shard& s, const engine::Verdict& v) {
   if (withhold_) {
     ++withheld_verdicts_;
     return;
   }
-  if (mark_handover_) {
-    ++replayed_verdicts_;
-    outputs_.set_mark(",\"handover\":true");
+  // A verdict of an instance that began mid-history (a late joiner, a window
+  // that lost the shard's oldest messages) need not be the uninterrupted
+  // monitor's: its discrete steps count from the replay's first message, and
+  // unbounded operators miss what came before. Marked "partial", so a reader
+  // never takes it for the same (property, time) as the first owner's.
+  const char* mark = s.partial ? (mark_handover_ ? ",\"handover\":true,\"partial\":true" : ",\"partial\":true")
+                               : (mark_handover_ ? ",\"handover\":true" : nullptr);
+  if (mark_handover_) ++replayed_verdicts_;
+  if (!mark) {
     outputs_.put(v);
-    outputs_.set_mark("");
     return;
   }
+  outputs_.set_mark(mark);
   outputs_.put(v);
+  outputs_.set_mark("");
 }
 
 void ShardedFeed::warn(const io::LineError& warning) {

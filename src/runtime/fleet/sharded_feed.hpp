@@ -92,6 +92,7 @@ class ShardedFeed final : public Feed {
     bool backup = false;             // subscribe_owned: this replica is its second choice (keeps its window)
     bool evicted = false;            // the window lacks the shard's oldest messages: the replay starts mid-history
     bool started = false;            // its first message came: owned or not, it is known
+    bool partial = false;            // its instance began mid-history: its verdicts are marked "partial"
     uint64_t inputs_seen = 0;        // inputs (bit i, the first 64) whose first message this replica has had
     PipelineStats replay;            // of the instance's stats, what its replays counted
     uint64_t replay_received = 0;
@@ -100,7 +101,7 @@ class ShardedFeed final : public Feed {
   Shard& shard(std::string_view key);
   void take(Shard& s, std::chrono::steady_clock::time_point changed_at);
   void release(Shard& s);
-  void on_verdict(const engine::Verdict& v);
+  void on_verdict(const Shard& s, const engine::Verdict& v);
   void retire(Shard& s);
   bool keeps_window(Shard& s);
 
