@@ -139,10 +139,10 @@ void GroupFlags::leave(bool at_end_of_stream) {
       std::fprintf(stderr, "rvc: group %s: could not say bye: %s\n", name.c_str(), e.what());
     }
   }
-#else
-  (void)at_end_of_stream;
-#endif
   if (shard_subs_) std::static_pointer_cast<transport::ZenohShardSubscriptions>(shard_subs_)->close();
+#else
+  (void)at_end_of_stream;  // without Zenoh no group starts (no session, no per-shard subscriptions)
+#endif
   byes_.reset();
   token_.reset();
   watch_.reset();
