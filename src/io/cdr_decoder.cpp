@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "io/cdr_cursor.hpp"
+#include "io/quant_settle.hpp"
 
 namespace rvc::io {
 
@@ -379,23 +380,11 @@ bool CdrDecoder::apply(const FieldPlan& f, const FieldValue& v) {
 
 // An array's quantifiers after its `elements` elements (as JsonDecoder's).
 bool CdrDecoder::finish_quantifiers(const FieldPlan& f, uint32_t elements) {
-  for (int id : f.quant_ids) {
-    double margin = 0;
-    std::string problem;
-    const int r = quant_finish(atoms_.tests()[id], folds_[id], elements, margin, problem);
-    if (r >= 0) {
-      next_[id] = static_cast<uint8_t>(r);
-      if (options_.robustness) next_margin_[id] = margin;
-      continue;
-    }
-    if (options_.strict) {
-      *error_ = problem;
-      refused_ = true;
-      return false;
-    }
-    if (warnings_) warnings_->push_back(problem + "; it keeps its previous value");
-  }
-  return true;
+  if (settle_quantifiers(f.quant_ids, atoms_.tests(), folds_, elements, next_,
+                         options_.robustness ? &next_margin_ : nullptr, options_.strict, *error_, warnings_))
+    return true;
+  refused_ = true;
+  return false;
 }
 
 // Fields no test reads are checked, not looked at: fixed-size numbers are

@@ -9,6 +9,7 @@
 
 #include "io/field_tests.hpp"
 #include "io/raw_key.hpp"
+#include "io/quant_settle.hpp"
 
 namespace rvc::io {
 
@@ -547,22 +548,8 @@ bool JsonDecoder::apply_value(KeyNode& node, const FieldValue& v, std::string& e
 // (an element without a usable value) the problem, as a wrong-type field.
 bool JsonDecoder::finish_quantifiers(const KeyNode& node, uint32_t elements, std::string& error,
                                      std::vector<std::string>* warnings) {
-  for (int id : node.quant_ids) {
-    double margin = 0;
-    std::string problem;
-    const int r = quant_finish(atoms_.tests()[id], folds_[id], elements, margin, problem);
-    if (r >= 0) {
-      next_[id] = static_cast<uint8_t>(r);
-      if (options_.robustness) next_margin_[id] = margin;
-      continue;
-    }
-    if (options_.strict) {
-      error = problem;
-      return false;
-    }
-    if (warnings) warnings->push_back(problem + "; it keeps its previous value");
-  }
-  return true;
+  return settle_quantifiers(node.quant_ids, atoms_.tests(), folds_, elements, next_,
+                            options_.robustness ? &next_margin_ : nullptr, options_.strict, error, warnings);
 }
 
 // The field an array quantifier reads is no array: its quantifiers keep
