@@ -92,6 +92,34 @@ def masked(uri):
     return re.sub(r"(://[^/:@]*:)[^@/]*@", r"\1***@", uri)
 
 
+OUTPUT_MARK = "user.rvc.output"  # what rvc itself marks its files with (src/transport/output_file.cpp)
+
+
+def not_ours(path):
+    """Why rvc-batch must not write `path`, or None: an existing, non-empty regular file (or a link to
+    one) that no rvc tool created is somebody else's, and is never truncated."""
+    try:
+        if not os.path.isfile(path) or os.path.getsize(path) == 0:
+            return None
+        os.getxattr(path, OUTPUT_MARK)
+        return None
+    except OSError:
+        return "%s: it exists and rvc did not write it: refusing to write over it" % path
+
+
+def open_output(path):
+    f = open(path, "w")
+    try:
+        os.setxattr(f.fileno(), OUTPUT_MARK, b"1")
+    except OSError:
+        pass  # a file system without user xattrs: the file is still written
+    return f
+
+
+def verdicts_path(out_dir, bag):
+    return os.path.join(out_dir, re.sub(r"[^A-Za-z0-9._-]", "_", bag.strip("/")) + ".jsonl")
+
+
 def check_bag(rvc, bag, check_args, store, out_dir=None, timeout=None):
     """Runs `rvc check` on one bag (on a Dask worker); never raises: a failure is a result."""
     cmd = [rvc, "check", bag] + list(check_args) + ["--stats"] + (["-o", store] if store else [])
@@ -100,8 +128,7 @@ def check_bag(rvc, bag, check_args, store, out_dir=None, timeout=None):
     rec = {"bag": bag, "exit": None, "seconds": 0.0, "stats": None, "run": None, "error": None}
     try:
         if out_dir:
-            name = re.sub(r"[^A-Za-z0-9._-]", "_", bag.strip("/")) + ".jsonl"
-            out = open(os.path.join(out_dir, name), "w")
+            out = open_output(verdicts_path(out_dir, bag))
             rec["verdicts"] = out.name
         p = subprocess.Popen(cmd, stdout=out, stderr=subprocess.PIPE, text=True)
         try:
@@ -230,6 +257,14 @@ def main(argv=None):
     except (FileNotFoundError, OSError) as e:
         say("no such bag or folder: %s" % e)
         return 2
+    # Before any bag runs: a file rvc-batch would write over that it did not create is refused.
+    planned = ([args.summary] if args.summary else []) + \
+        ([verdicts_path(args.out_dir, b) for b in bags] if args.out_dir else [])
+    for path in planned:
+        problem = not_ours(path)
+        if problem:
+            say(problem)
+            return 2
     if not bags:
         say("no bag found in %s (.mcap, .db3, folders with metadata.yaml)" % " ".join(args.bags))
         print(json.dumps({"bags": 0, "held": 0, "violated": 0, "failed": 0}))
@@ -281,7 +316,7 @@ def main(argv=None):
     held = sum(1 for r in records if not failed(r) and r["exit"] == HELD)
     violated = len(records) - bad - held
     if args.summary:
-        with open(args.summary, "w") as f:
+        with open_output(args.summary) as f:
             for r in records:
                 f.write(json.dumps(r) + "\n")
     if bad:

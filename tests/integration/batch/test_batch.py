@@ -133,6 +133,37 @@ def test_nothing_to_check_and_bad_paths(rvc, tmp_path):
     assert not (tmp_path / "x.db").exists()
 
 
+def test_files_it_did_not_create_are_never_written_over(rvc, bags, tmp_path):
+    """--summary and --out-dir files: a foreign file keeps its bytes (exit 2, nothing run); the tool's
+    own earlier output and an empty file are written as before."""
+    d, paths, _ = bags
+    one = os.path.join(paths[0], "bag-0000.mcap")
+    foreign = tmp_path / "summary.jsonl"
+    foreign.write_text("precious\n")
+    store = tmp_path / "s.db"
+    r = batch(rvc, one, "--store", "sqlite:%s" % store, "--summary", str(foreign), "--no-progress",
+              "--", "--spec", "{data < 1000}")
+    assert r.returncode == 2 and "rvc did not write it" in r.stderr, r.stderr
+    assert foreign.read_text() == "precious\n" and not store.exists()
+    out_dir = tmp_path / "out"
+    out_dir.mkdir()
+    target = out_dir / (one.strip("/").replace("/", "_") + ".jsonl")
+    target.write_text("precious\n")
+    r = batch(rvc, one, "--store", "sqlite:%s" % store, "--out-dir", str(out_dir), "--no-progress",
+              "--", "--spec", "{data < 1000}")
+    assert r.returncode == 2 and str(target) in r.stderr, r.stderr
+    assert target.read_text() == "precious\n"
+    target.unlink()
+    mine = tmp_path / "mine.jsonl"
+    mine.write_text("")
+    for _ in range(2):  # an empty file, then the tool's own output: written both times
+        r = batch(rvc, one, "--store", "sqlite:%s" % store, "--summary", str(mine), "--out-dir", str(out_dir),
+                  "--no-progress", "--", "--spec", "{data < 1000}")
+        assert r.returncode in (0, 1), r.stderr
+        assert json.loads(mine.read_text().splitlines()[0])["bag"] == one
+        assert target.read_text() != ""
+
+
 def test_a_bag_past_its_timeout_is_stopped_and_counted(rvc, bags, tmp_path):
     d, paths, _ = bags
     # 1 microsecond: no rvc can start, read a bag and end in that time, so every bag is stopped
