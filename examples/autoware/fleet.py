@@ -180,6 +180,11 @@ def main(argv=None) -> int:
         print(" ".join(monitor_flags(topics, args.prefix)))
         return 0
     log = lambda s: print(s, file=sys.stderr, flush=True)  # noqa: E731
+    if args.record and os.path.isdir(args.record) and os.listdir(args.record):
+        # Its bags, vehicles.json and sent.json are the oracle of a run: never mixed with, or
+        # written over, what the folder already holds.
+        log(f"fleet: --record {args.record}: the folder is not empty: refusing to write into it")
+        return 2
     if args.plan_cache and os.path.exists(args.plan_cache):
         with open(args.plan_cache, "rb") as f:
             fleet = pickle.load(f)
