@@ -476,7 +476,8 @@ class Parser {
     if (peek() == '"') {
       const size_t at = pos_;
       std::string key = parse_quoted();
-      if (is_index_part(key)) fail("a key written like an array element (\"" + key + "\") is ambiguous", at);
+      if (is_index_part(key) || is_every_part(key))
+        fail("a key written like an array element (\"" + key + "\") is ambiguous", at);
       return key;
     }
     if (!is_ident_start(peek())) {

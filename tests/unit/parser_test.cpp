@@ -448,6 +448,14 @@ TEST(ParserErrors, Bounds) {
   expect_error("{a} since[2:1] {b}", "empty time interval", 10);
 }
 
+TEST(ParserErrors, KeysThatReadAsElements) {
+  // A quoted key spelt like an element would print back as one: {"[*]" == "a"}
+  // printed as {[*] == "a"} (found by fuzz_spec in CI).
+  expect_error("{\"[0]\" == 1}", "a key written like an array element", 2);
+  expect_error("{\"[*]\" == \"a\"}", "a key written like an array element", 2);
+  expect_error("{a.\"[*]\"}", "a key written like an array element", 4);
+}
+
 TEST(ParserErrors, ChainedSince) {
   // "{a} since {b} " is 14 characters.
   expect_error("{a} since {b} since {c}", "chained 'since' is ambiguous", 15);
