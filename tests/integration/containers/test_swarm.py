@@ -24,31 +24,59 @@ PG_IMAGE = os.environ.get("RVC_POSTGRES_IMAGE", "rvc-postgres:15")
 STEPS = 2000
 
 
+SWARM_LABEL = "rvc.test.swarm"  # on the node of a swarm this test made
+POOL = "172.29.0.0/16"
+
+
 def swarm_state():
     return run(["docker", "info", "--format", "{{.Swarm.LocalNodeState}}"]).stdout.strip()
 
 
+def left_by_us():
+    """A swarm this test made in a run that was killed before its teardown (CI stopped, the session
+    ended): its node carries our label, or -- made before the label existed -- it is one node on
+    127.0.0.1 with our address pool. After dockerd restarts, such a swarm keeps its state but its
+    overlay networks cannot be allocated again ("could not find local network state"): tasks stay
+    in state New forever. It is ours to remove; any other swarm is left as it is."""
+    label = run(["docker", "node", "inspect", "self", "--format",
+                 '{{index .Spec.Labels "%s"}}' % SWARM_LABEL]).stdout.strip()
+    info = run(["docker", "info", "--format",
+                "{{.Swarm.NodeAddr}} {{.Swarm.Nodes}} {{json .Swarm.Cluster.DefaultAddrPool}}"]).stdout.split()
+    return label == "1" or info == ["127.0.0.1", "1", '["%s"]' % POOL]
+
+
+def init_swarm():
+    r = run(["docker", "swarm", "init", "--advertise-addr", "127.0.0.1", "--listen-addr", "127.0.0.1:2377",
+             "--default-addr-pool", POOL, "--default-addr-pool-mask-length", "24"], timeout=60)
+    if r.returncode != 0:
+        pytest.fail("docker swarm init failed: " + r.stderr)
+    run(["docker", "node", "update", "--label-add", SWARM_LABEL + "=1", "self"], timeout=30)
+
+
+def networks():
+    # This host's own networks (a swarm's overlays go with the swarm, some moments after it).
+    return set(run(["docker", "network", "ls", "--filter", "scope=local", "--format", "{{.Name}}"]).stdout.split())
+
+
 @pytest.fixture
 def swarm(docker):  # noqa: F811
-    """A one-node swarm: this host's if it is one already (left as it is), else one made here."""
-    before = set(run(["docker", "network", "ls", "--format", "{{.Name}}"]).stdout.split())
-    ours = False
-    if swarm_state() == "inactive":
-        r = run(["docker", "swarm", "init", "--advertise-addr", "127.0.0.1", "--listen-addr", "127.0.0.1:2377",
-                 "--default-addr-pool", "172.29.0.0/16", "--default-addr-pool-mask-length", "24"], timeout=60)
-        if r.returncode != 0 and swarm_state() != "active":
-            pytest.fail("docker swarm init failed: " + r.stderr)
-        ours = r.returncode == 0
+    """A one-node swarm made here (and removed at the end), or this host's own (left as it is)."""
+    if swarm_state() == "active" and left_by_us():
+        run(["docker", "swarm", "leave", "--force"], timeout=60)
+        run(["docker", "network", "rm", "docker_gwbridge"])  # made with that swarm
+        assert swarm_state() == "inactive"
+    before = networks()
+    ours = swarm_state() == "inactive"
+    if ours:
+        init_swarm()
     assert swarm_state() == "active"
     yield
     if ours:
         run(["docker", "swarm", "leave", "--force"], timeout=60)
-        for net in ("docker_gwbridge",):
-            if net not in before:
-                run(["docker", "network", "rm", net])
+        if "docker_gwbridge" not in before:
+            run(["docker", "network", "rm", "docker_gwbridge"])
         assert swarm_state() == "inactive"
-        after = set(run(["docker", "network", "ls", "--format", "{{.Name}}"]).stdout.split())
-        assert after == before, "networks left behind: %s" % (after - before)
+        assert networks() == before, "networks left behind: %s" % (networks() - before)
 
 
 def psql(container, sql):
@@ -110,9 +138,15 @@ def test_swarm_stack_router_monitors_postgres_scale(image, swarm, tmp_path):  # 
     env = dict(os.environ, RVC_IMAGE=IMAGE, RVC_POSTGRES_IMAGE=PG_IMAGE, RVC_PROPERTIES=str(d / "props.yaml"),
                RVC_TRACE=str(d / "trace.jsonl"), RVC_PG_PASSWORD_FILE=str(d / "pw"),
                RVC_PGPASS_FILE=str(d / "pgpass"), RVC_MONITORS="2")
-    logs = lambda: "\n".join(run(["docker", "service", "logs", "--tail", "20", "%s_%s" % (stack, s)]).stdout  # noqa
-                             + run(["docker", "service", "logs", "--tail", "20", "%s_%s" % (stack, s)]).stderr
-                             for s in ("monitor", "replay", "router", "postgres"))
+    def logs():
+        # The scheduler's view first (a task stuck in New or Pending says why there), then each
+        # service's last lines.
+        out = [run(["docker", "stack", "ps", "--no-trunc", "--format",
+                    "{{.Name}} {{.CurrentState}} {{.Error}}", stack]).stdout]
+        for s in ("monitor", "replay", "router", "postgres"):
+            r = run(["docker", "service", "logs", "--tail", "20", "%s_%s" % (stack, s)])
+            out.append(r.stdout + r.stderr)
+        return "\n".join(out)
     try:
         r = run(["docker", "stack", "deploy", "--resolve-image", "never", "-c", STACK_FILE, stack], env=env,
                 timeout=120)
