@@ -704,7 +704,12 @@ class Parser {
     const size_t atom_at = parse_path(t);
     if (t.is_timed()) return finish_timing_atom(std::move(t), atom_at);
     skip_ws();
-    if (is_arithmetic(peek())) return finish_expression_test(std::move(t), parse_expr(field_expr(t.path, path_at)));
+    if (is_arithmetic(peek())) {
+      // The expression is read before t is moved: function arguments are evaluated in no fixed
+      // order (clang moved t first and the field's path was lost; fuzz_spec found it).
+      ExprPtr lhs = parse_expr(field_expr(t.path, path_at));
+      return finish_expression_test(std::move(t), std::move(lhs));
+    }
     size_t op_at = pos_;
     using FOp = FieldTest::Op;
     if (peek() == ',' || peek() == '}' || (in_quantifier_ && peek() == ')')) { t.op = FOp::Truthy; return t; }
