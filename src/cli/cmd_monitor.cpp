@@ -55,6 +55,7 @@ struct MonitorCommand {
   double idle_timeout = 0;
   double stats_interval = 0;
   size_t queue_capacity = 1 << 14;
+  std::string handoff = "auto";        // --handoff: queue | inline | auto (runtime/monitor_loop.hpp)
   size_t wait_subscribers = 0;  // per network output, before subscribing to the input
   double wait_timeout = 10;
   TypeOptions typed;                   // --type: payloads are CDR samples of this ROS 2 type
@@ -464,6 +465,8 @@ struct MonitorCommand {
     lopts.idle_timeout = idle_timeout;
     lopts.stats_interval = stats_interval;
     lopts.queue_capacity = queue_capacity;
+    using Handoff = runtime::LoopOptions::Handoff;
+    lopts.handoff = handoff == "queue" ? Handoff::Queue : handoff == "inline" ? Handoff::Inline : Handoff::Auto;
     lopts.stop_requested = stop_requested;
     lopts.stats_requested = stats_requested;
     clock.apply(lopts, check.dense || check.calls, from_file);  // --calls: unanswered calls are due on the clock
@@ -546,6 +549,18 @@ struct MonitorCommand {
     }
     if (!bag)
       if (int status = refuse_input_copies(outputs, inputs.at(0))) return status;
+    if (handoff == "inline")  // the receive thread checks: only a transport whose callbacks may block
+      for (const std::string& in : inputs) {
+        const auto eq = in.find('=');
+        const std::string uri = SyncFlags::named(inputs) && eq != std::string::npos ? in.substr(eq + 1) : in;
+        const std::string scheme = transport::scheme_of(uri);
+        if ((scheme != "zenoh" && scheme != "rmw_zenoh") || group.given()) {
+          std::fprintf(stderr, "rvc: --handoff inline checks each message on its transport's receive thread, which "
+                               "only zenoh: and rmw_zenoh: inputs allow (%s): use --handoff queue or auto\n",
+                       group.given() ? "not a --group's shard subscriptions" : ("not " + uri).c_str());
+          return kUsage;
+        }
+      }
     if (SyncFlags::named(inputs)) return run_synced();
     if (!bag && refuse_binary_file(inputs.at(0))) return kUsage;
     if (!bag && (!sync.stamps.empty() || app->count("--sync") || app->count("--pivot") || app->count("--lower-bound"))) {
@@ -743,6 +758,13 @@ Runner register_monitor(CLI::App& app) {
   cmd->clock.add_live(*sub);
   sub->add_option("--queue", cmd->queue_capacity, "Messages buffered between transport and engine")
       ->check(in_range(1, kMaxQueue))
+      ->capture_default_str();
+  sub->add_option("--handoff", cmd->handoff,
+                  "How messages reach the checker: inline (on the transport's receive thread, no queue and no "
+                  "wake-up between message and verdict: the lowest latency; Zenoh inputs), queue (a bounded queue "
+                  "to the checker's thread), auto (inline where every input allows it, i.e. Zenoh; DDS and files "
+                  "queue)")
+      ->check(CLI::IsMember({"auto", "queue", "inline"}))
       ->capture_default_str();
   add_transport_options(*sub, cmd->transports);
   sub->footer(

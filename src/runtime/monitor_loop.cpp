@@ -4,6 +4,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <condition_variable>
+#include <exception>
+#include <mutex>
 #include <cstdio>
 #include <cstdlib>
 #include <string_view>
@@ -106,7 +109,8 @@ std::string MonitorLoop::stats_json() const {
   out
       .add("verdicts", outputs_.count())
       .add("violations", feed_.violations())
-      .add("eos", eos_);
+      .add("eos", eos_)
+      .add("handoff", handoff());
   if (!options_.input_names.empty()) {
     io::JsonArray inputs;
     for (size_t i = 0; i < counters_.size(); ++i) {
@@ -337,6 +341,20 @@ std::chrono::steady_clock::time_point MonitorLoop::wake_at(std::chrono::steady_c
   return wake;
 }
 
+void MonitorLoop::arrive(const transport::Frame& f, std::chrono::steady_clock::time_point now) {
+  if (f.input == kRosClockInput) {
+    // In arrival order with the data: a message after a /clock message is
+    // checked after that clock's ticks. /clock is no data: a simulator's
+    // clock running on does not hold off --idle-timeout while the checked
+    // inputs are silent.
+    if (!f.eos) follow_ros_clock(f.payload, now);
+    return;
+  }
+  last_message_ = now;
+  if (first_at_ == 0) first_at_ = wall_now();
+  handle(f);
+}
+
 void MonitorLoop::process(const std::vector<transport::Source*>& sources) {
   counters_.assign(sources.size(), transport::SeqCounters{});
   input_eos_.assign(sources.size(), false);
@@ -345,7 +363,7 @@ void MonitorLoop::process(const std::vector<transport::Source*>& sources) {
     c.expect(options_.publishers);
     if (options_.join_mid_stream) c.join_mid_stream();
   }
-  last_stats_ = last_record_ = last_tick_ = std::chrono::steady_clock::now();
+  last_stats_ = last_record_ = last_tick_ = last_message_ = std::chrono::steady_clock::now();
   clock_ = StreamClock(options_.clock, options_.time);
   // Deadlines are met to the timer's precision: the kernel may defer a
   // sleeping thread's wake-up by its timer slack (50 us by default); 1 us
@@ -358,14 +376,22 @@ void MonitorLoop::process(const std::vector<transport::Source*>& sources) {
   // samples on its own waitset thread.
   const char* handoff = std::getenv("RVC_HANDOFF");
   const bool legacy = handoff && std::string_view(handoff) == "sleep";
-  transport::FrameQueue queue(options_.queue_capacity,
-                              legacy ? std::chrono::microseconds(0) : transport::FrameQueue::kSpin);
   std::vector<transport::Source*> started = sources;
   const bool ros_clock = options_.clock == ClockKind::Ros && options_.ros_clock;
   if (ros_clock) {
     ros_clock_reader_ = std::make_unique<RosClockReader>(*options_.ros_clock_type);
     started.push_back(options_.ros_clock);
   }
+  const bool may_inline =
+      std::all_of(started.begin(), started.end(), [](const transport::Source* s) { return s->handler_may_block(); });
+  using Handoff = LoopOptions::Handoff;
+  if (options_.handoff == Handoff::Inline && !may_inline)
+    throw std::runtime_error("--handoff inline: an input's transport thread must not block (DDS, files): "
+                             "use --handoff queue (or auto)");
+  if (may_inline && !legacy && options_.handoff != Handoff::Queue) return process_inline(started, sources.size());
+
+  transport::FrameQueue queue(options_.queue_capacity,
+                              legacy ? std::chrono::microseconds(0) : transport::FrameQueue::kSpin);
   Shutdown shutdown(queue, started);
   for (size_t i = 0; i < started.size(); ++i) {
     const auto input = ros_clock && i == sources.size() ? kRosClockInput : static_cast<uint32_t>(i);
@@ -384,7 +410,6 @@ void MonitorLoop::process(const std::vector<transport::Source*>& sources) {
 
   using clock = std::chrono::steady_clock;
   const auto idle_limit = std::chrono::duration<double>(options_.idle_timeout);
-  auto last_message = clock::now();
   auto next_tick = clock::time_point::max();
   std::vector<transport::OwnedFrame> batch;
   size_t count = 0;
@@ -395,7 +420,7 @@ void MonitorLoop::process(const std::vector<transport::Source*>& sources) {
     }
     // No polling period: the wait ends at a message, at the next tick's
     // deadline, or at the next scheduled duty, whichever comes first.
-    if (!queue.pop_batch_until(batch, count, wake_at(clock::now(), next_tick, last_message))) {
+    if (!queue.pop_batch_until(batch, count, wake_at(clock::now(), next_tick, last_message_))) {
       end_ = EndReason::SourceClosed;
       break;
     }
@@ -403,7 +428,7 @@ void MonitorLoop::process(const std::vector<transport::Source*>& sources) {
     if (count == 0) {
       feed_.idle();
       outputs_.idle();
-      if (options_.idle_timeout > 0 && now - last_message >= idle_limit) {
+      if (options_.idle_timeout > 0 && now - last_message_ >= idle_limit) {
         end_ = EndReason::IdleTimeout;
         break;
       }
@@ -411,16 +436,6 @@ void MonitorLoop::process(const std::vector<transport::Source*>& sources) {
       batch_at_ = now;
       for (size_t i = 0; i < count; ++i) {
         const transport::OwnedFrame& o = batch[i];
-        if (o.input == kRosClockInput) {
-          // In arrival order with the data: a message after a /clock
-          // message is checked after that clock's ticks. /clock is no
-          // data: a simulator's clock running on does not hold off
-          // --idle-timeout while the checked inputs are silent.
-          if (!o.eos) follow_ros_clock(o.payload, now);
-          continue;
-        }
-        last_message = now;
-        if (first_at_ == 0) first_at_ = wall_now();
         transport::Frame f;
         f.payload = o.payload;
         f.seq = o.seq;
@@ -428,7 +443,7 @@ void MonitorLoop::process(const std::vector<transport::Source*>& sources) {
         f.publisher = o.publisher;
         f.input = o.input;
         f.key = o.key;
-        handle(f);
+        arrive(f, now);
       }
       follow_stamps(now);
     }
@@ -442,9 +457,99 @@ void MonitorLoop::process(const std::vector<transport::Source*>& sources) {
   shutdown.now();
 }
 
+void MonitorLoop::process_inline(const std::vector<transport::Source*>& started, size_t checked_inputs) {
+  using clock = std::chrono::steady_clock;
+  // Buffered outputs (a file, stdout, the results store) are flushed once no
+  // message came for this long: as the queue's engine flushes when it finds
+  // the queue empty, without a flush per message in a steady stream.
+  constexpr auto kFlushAfter = std::chrono::milliseconds(1);
+  handoff_ = "inline";
+  std::mutex engine;  // the feed, the outputs, the counters and the clock
+  std::condition_variable wake;
+  bool closed = false, poke = false, dirty = false;
+  std::exception_ptr failure;  // an output failed on a source's thread: the run ends with it
+  auto next_tick = clock::time_point::max();
+  auto planned = clock::time_point::max();  // when this thread means to wake next
+  std::unique_lock<std::mutex> lock(engine, std::defer_lock);
+
+  // However this function is left: no handler runs past this point, then
+  // the sources stop (stop() waits for a handler that may be waiting for
+  // the lock: it is released first).
+  struct Stop {
+    std::unique_lock<std::mutex>& lock;
+    bool& closed;
+    const std::vector<transport::Source*>& sources;
+    ~Stop() {
+      if (!lock.owns_lock()) lock.lock();
+      closed = true;
+      lock.unlock();
+      for (transport::Source* s : sources) s->stop();
+    }
+  } stop{lock, closed, started};
+
+  for (size_t i = 0; i < started.size(); ++i) {
+    const auto input = i == checked_inputs ? kRosClockInput : static_cast<uint32_t>(i);
+    started[i]->start([&, input](const transport::Frame& f) {
+      std::unique_lock<std::mutex> held(engine);
+      if (closed || failure) return;
+      const auto now = clock::now();
+      try {
+        transport::Frame tagged = f;
+        tagged.input = input;
+        batch_at_ = now;
+        arrive(tagged, now);
+        if (input != kRosClockInput) follow_stamps(now);
+        next_tick = run_ticks(now, false);
+        dirty = true;
+      } catch (...) {
+        failure = std::current_exception();
+      }
+      // This thread wakes the loop only when it has to: the run ends, or
+      // the loop sleeps past a new deadline or past the next flush.
+      if (failure || (eos_ && options_.exit_on_eos) || std::min(next_tick, now + kFlushAfter) < planned) {
+        poke = true;
+        held.unlock();
+        wake.notify_one();
+      }
+    });
+  }
+  lock.lock();
+
+  const auto idle_limit = std::chrono::duration<double>(options_.idle_timeout);
+  for (;;) {
+    if (failure) std::rethrow_exception(failure);
+    if (options_.stop_requested()) {
+      end_ = EndReason::Stopped;
+      break;
+    }
+    if (eos_ && options_.exit_on_eos) {
+      end_ = EndReason::EndOfStream;
+      break;
+    }
+    planned = wake_at(clock::now(), next_tick, last_message_);
+    if (dirty) planned = std::min(planned, last_message_ + kFlushAfter);
+    poke = false;
+    const bool poked = wake.wait_until(lock, planned, [&] { return poke; });
+    if (failure || (eos_ && options_.exit_on_eos)) continue;
+    const auto now = clock::now();
+    if (now - last_message_ >= kFlushAfter) {
+      feed_.idle();
+      outputs_.idle();
+      dirty = false;
+      if (options_.idle_timeout > 0 && now - last_message_ >= idle_limit) {
+        end_ = EndReason::IdleTimeout;
+        break;
+      }
+    }
+    next_tick = run_ticks(now, !poked);
+    on_schedule(now);
+  }
+}
+
 void MonitorLoop::process_in_order(const std::vector<transport::Source*>& sources) {
   for (transport::Source* s : sources)
     if (!s->pullable()) throw std::logic_error("inputs merged by stamp must be files");
+  handoff_ = "read";
   using clock = std::chrono::steady_clock;
   const auto idle_limit = std::chrono::duration<double>(options_.idle_timeout);
   auto last_message = clock::now();

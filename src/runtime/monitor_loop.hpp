@@ -62,6 +62,16 @@ struct LoopOptions {
   double idle_timeout = 0;       // seconds without any message before giving up; 0: wait forever
   double stats_interval = 0;     // seconds between counter lines; 0: only on request
   size_t queue_capacity = 1 << 14;
+  // How frames reach the engine (--handoff, docs/performance.md "Inline hand-off"):
+  // Queue: a bounded queue to this thread (the engine), which wakes for them.
+  // Inline: the source's own thread checks each frame under the engine's lock
+  //   and publishes its verdicts (as a ping's pong answers on its receive
+  //   thread): no queue and no wake-up between message and verdict; this
+  //   thread keeps the clock, the schedule and the idle flushes.
+  // Auto: Inline when every source allows it (Source::handler_may_block:
+  //   Zenoh), else Queue.
+  enum class Handoff { Auto, Queue, Inline };
+  Handoff handoff = Handoff::Auto;
   // Frames carry a publisher's sequence numbers (loss accounting). A file's
   // frames carry line numbers instead: blank lines are not lost messages.
   bool sequence_numbers = true;
@@ -122,6 +132,9 @@ class MonitorLoop {
   // The counters and each input's silence at `now` (engine thread).
   LoopHealth health(std::chrono::steady_clock::time_point now) const;
   uint64_t ticks() const { return ticks_; }
+  // How this run's frames reached the engine, in the counters line: "queue",
+  // "inline" (LoopOptions::Handoff) or "read" (files read by this thread).
+  const char* handoff() const { return handoff_; }
   // The counters printed at the end of run().
   const std::string& final_stats() const { return final_stats_; }
 
@@ -131,6 +144,10 @@ class MonitorLoop {
   // Files merged by stamp (Feed::reads_in_order): read on this thread, each
   // the next message of the input the feed asks for.
   void process_in_order(const std::vector<transport::Source*>& sources);
+  // Handoff::Inline: each source's thread handles its frames under a lock.
+  void process_inline(const std::vector<transport::Source*>& started, size_t checked_inputs);
+  // One frame as it arrives, on either path; `now`: its arrival.
+  void arrive(const transport::Frame& frame, std::chrono::steady_clock::time_point now);
   void handle(const transport::Frame& frame);  // one frame of either path
   // Counters on request or on schedule; false once the run should end.
   void on_schedule(std::chrono::steady_clock::time_point now);
@@ -177,6 +194,8 @@ class MonitorLoop {
   // tick_lag_us (the first 65,536).
   std::vector<float> tick_lag_;
   std::chrono::steady_clock::time_point last_tick_{};
+  const char* handoff_ = "queue";
+  std::chrono::steady_clock::time_point last_message_{};  // for --idle-timeout and the idle flushes
   double first_at_ = 0;  // wall clock of the first message (benchmarks compare across processes)
 };
 

@@ -38,6 +38,12 @@ class Source {
     (void)frame;
     return PullResult::End;
   }
+  // The handler may block this source's thread and do the engine's work
+  // there (rvc monitor's inline hand-off, LoopOptions::Handoff): true for
+  // Zenoh, whose callbacks may block (backpressure, as a full queue does);
+  // false for threads that must never block (CycloneDDS's receive thread
+  // also carries the acknowledgements a verdict writer waits for).
+  virtual bool handler_may_block() const { return false; }
   // What the transport knows about why messages may not arrive (a publisher
   // whose QoS this subscriber cannot match), for the end-of-run report; empty
   // if nothing is known.

@@ -31,6 +31,7 @@ class ZenohSource : public Source {
   ~ZenohSource() override;
   void start(FrameHandler handler) override;
   void stop() override;
+  bool handler_may_block() const override { return true; }
   const std::string& keyexpr() const { return keyexpr_; }
 
  private:
