@@ -11,7 +11,9 @@ monitor's last verdict (`done_at`), beside `rvc check` on the same file (best of
 counters (gaps + duplicates + sent - received + sent - checked). Transports: dds (CycloneDDS on lo,
 reliable keep-all, rvc's defaults: replay packs samples into packets), dds-1pkt (the same with
 `--no-dds-write-batch`: one UDP packet per sample, the old default), zenoh-p2p (two peers over
-tcp/127.0.0.1), zenoh-router (both clients of an `rvc router`).
+tcp/127.0.0.1; the monitor checks on Zenoh's receive thread, `--handoff inline`, its default there),
+zenoh-queue (the same with `--handoff queue`: a queue to the checker's thread, the old default),
+zenoh-router (both clients of an `rvc router`).
 
 Baselines, measured in the same run, interleaved with the files (--baseline-reps times, median):
 - DDS: `ddsperf pub size S` -> `ddsperf sub` (reliable keep-all, what ddsperf does: write batching), S =
@@ -21,7 +23,8 @@ Baselines, measured in the same run, interleaved with the files (--baseline-reps
 - CPU per sample (user + sys of each process, /usr/bin/time) of every publisher and subscriber, and
   the ratio it implies where the CPU is the limit (2 cores, both processes busy): baseline (pub + sub)
   CPU per sample / rvc (replay + monitor) CPU per sample; less noisy than samples/s on a loaded machine;
-- the cause, measured: dds-1pkt (one UDP packet per sample) on the first --cause-files files;
+- the cause, measured: dds-1pkt (one UDP packet per sample) and zenoh-queue (the queued hand-off) on
+  the first --cause-files files, and zenoh-queue's latency beside zenoh-p2p's;
 - "baseline-bound network / local": the file's samples at the baseline's rate / `rvc check`'s time,
   the best a monitor that cost nothing could do with one sample per event.
 Latency: publish -> verdict received back (`rvc monitor --all`, `rvc replay --latency-from`), a round
@@ -116,6 +119,8 @@ class Setup:
             else:
                 self.mon = ["--mode", "peer", "--listen", ep, "--no-multicast-scouting"]
                 self.rep = ["--mode", "peer", "--connect", ep, "--no-multicast-scouting"]
+                if name == "zenoh-queue":
+                    self.mon = self.mon + ["--handoff", "queue"]
 
     def close(self):
         if self.router:
@@ -250,7 +255,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--quick", action="store_true", help="5 files of 200k events, 1 rep, short baselines (~1 min)")
     ap.add_argument("--transports", default="dds,zenoh-p2p",
-                    help="comma list of dds, dds-1pkt, zenoh-p2p, zenoh-router")
+                    help="comma list of dds, dds-1pkt, zenoh-p2p, zenoh-queue, zenoh-router")
     ap.add_argument("--steps", type=int, default=None, help="events per file (default 1M, --quick 200k)")
     ap.add_argument("--reps", type=int, default=None, help="rvc check repetitions, best taken (default 3, quick 1)")
     ap.add_argument("--families", default=None)
@@ -260,7 +265,9 @@ def main():
     ap.add_argument("--baseline-seconds", type=float, default=None, help="per baseline run (default 3, quick 2)")
     ap.add_argument("--baseline-reps", type=int, default=None, help="baseline runs per transport (default 3, quick 1)")
     ap.add_argument("--cause-files", type=int, default=1,
-                    help="also run dds-1pkt (--no-dds-write-batch, the old default) on the first N files (0: none)")
+                    help="also run dds-1pkt (--no-dds-write-batch) and zenoh-queue (--handoff queue), the old "
+                         "defaults, on the first N files (0: none)")
+    ap.add_argument("--latency-seconds", type=float, default=None, help="per latency run (default 5, quick 1)")
     ap.add_argument("--batch", type=int, default=1, help="events per published sample (rvc replay --batch)")
     ap.add_argument("--build", default=os.path.join(ROOT, "build", "release"))
     ap.add_argument("--no-docs", action="store_true")
@@ -318,8 +325,10 @@ def main():
                               capture_output=True, text=True, check=True).stdout.strip()
         local_s = local_best(ctx, spec, path, args.reps)
         row = dict(property=name, local_ms=local_s * 1e3, load=loadavg())
-        extra = ["dds-1pkt"] if n <= args.cause_files and "dds" in transports and "dds-1pkt" not in transports \
-            and args.batch == 1 else []
+        extra = []
+        if n <= args.cause_files and args.batch == 1:
+            extra += ["dds-1pkt"] if "dds" in transports and "dds-1pkt" not in transports else []
+            extra += ["zenoh-queue"] if "zenoh-p2p" in transports and "zenoh-queue" not in transports else []
         for t in transports + extra:
             stats, sent, cpu = run_pair(ctx, t, spec, path, extra_rep=["--batch", str(args.batch)])
             net_s = stats["done_at"] - sent["started_at"]
@@ -337,9 +346,12 @@ def main():
 
     latency = []
     if not args.skip_latency:
-        lat_secs = 1 if q else 3
-        trace_rates = [(1000, 1000 * lat_secs), (10000, 10000 * lat_secs)]
-        for t in [t for t in transports if t in ("dds", "zenoh-p2p")]:
+        lat_secs = args.latency_seconds or (1 if q else 5)
+        trace_rates = [(1000, int(1000 * lat_secs)), (10000, int(10000 * lat_secs))]
+        lat_transports = [t for t in transports if t in ("dds", "zenoh-p2p", "zenoh-queue")]
+        if "zenoh-p2p" in lat_transports and "zenoh-queue" not in lat_transports and args.cause_files:
+            lat_transports.insert(lat_transports.index("zenoh-p2p") + 1, "zenoh-queue")
+        for t in lat_transports:
             for rate, count in trace_rates:
                 trace = os.path.join(data, f"latency_{count}.jsonl")
                 if not os.path.exists(trace):
@@ -393,7 +405,7 @@ def rerender(args):
         if getattr(saved, k, None) is None:
             setattr(saved, k, v)
     transports = d.get("transports") or [k[:-3] for k in d["rows"][0] if k.endswith("_ms") and k != "local_ms"
-                                         and k != "dds-1pkt_ms"]
+                                         and k not in ("dds-1pkt_ms", "zenoh-queue_ms")]
     md = render(d["rows"], d["baselines"], d["latency"], transports, saved, d["size"], d["elapsed_s"],
                 d.get("command", "python3 bench/network_bench.py"))
     if saved.batch == 1:
@@ -449,13 +461,14 @@ def render(rows, base, latency, transports, args, size, elapsed, cmd):
             floor = med([args.steps / b / (r["local_ms"] / 1e3) for r in rows])
             bp, bs = med([x['pub_us'] for x in base[k]]), med([x['sub_us'] for x in base[k]])
             variants = [(t, label)]
-            if k == "dds" and any("dds-1pkt_per_s" in r for r in rows):
-                variants.append(("dds-1pkt", label))
+            for cause in ("dds-1pkt", "zenoh-queue"):
+                if cause.startswith(k) and cause not in transports and any(f"{cause}_per_s" in r for r in rows):
+                    variants.append((cause, label))
             for tv, lab in variants:
                 sel = [r for r in rows if f"{tv}_per_s" in r]
                 mine = med([r[f"{tv}_per_s"] for r in sel])
                 rp, rm = med([r[f"{tv}_rep_us"] for r in sel]), med([r[f"{tv}_mon_us"] for r in sel])
-                name = tv if tv != "dds-1pkt" else f"dds-1pkt ({len(sel)} file{'s' if len(sel) != 1 else ''})"
+                name = tv if tv == t else f"{tv} ({len(sel)} file{'s' if len(sel) != 1 else ''})"
                 out.append(f"| {name} | {lab} | {b / 1e3:.0f} | {mine / 1e3:.0f} | **{mine / b:.2f}** | "
                            f"{bp:.2f} / {bs:.2f} | {rp:.2f} / {rm:.2f} | {(bp + bs) / (rp + rm):.2f} | "
                            f"{floor:.2f} | {med([x['load'] for x in base[k]]):.1f} |")

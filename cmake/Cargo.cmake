@@ -2,7 +2,8 @@
 #
 #   rvc_cargo_staticlib(<target>
 #     MANIFEST_DIR <dir with Cargo.toml and Cargo.lock>
-#     LIB_NAME     <[lib] name in Cargo.toml, e.g. rvc_zenoh>)
+#     LIB_NAME     <[lib] name in Cargo.toml, e.g. rvc_zenoh>
+#     [FEATURES    <cargo features, comma-separated, e.g. shm>])
 #
 # Defines <target>, an INTERFACE library that links the resulting
 # lib<LIB_NAME>.a plus the system libraries a Rust std staticlib needs on
@@ -39,7 +40,7 @@ find_program(CARGO_EXECUTABLE cargo
   DOC "cargo, to build the Rust parts of rvc")
 
 function(rvc_cargo_staticlib target)
-  cmake_parse_arguments(ARG "" "MANIFEST_DIR;LIB_NAME" "" ${ARGN})
+  cmake_parse_arguments(ARG "" "MANIFEST_DIR;LIB_NAME;FEATURES" "" ${ARGN})
   if(NOT ARG_MANIFEST_DIR OR NOT ARG_LIB_NAME)
     message(FATAL_ERROR "rvc_cargo_staticlib(${target}): MANIFEST_DIR and LIB_NAME are required")
   endif()
@@ -67,6 +68,10 @@ function(rvc_cargo_staticlib target)
   if(NOT target_dir)
     set(target_dir "${CMAKE_BINARY_DIR}/cargo-target")
   endif()
+  if(ARG_FEATURES)  # its own target dir: the default build's library is never overwritten by this one
+    string(REPLACE "," "-" suffix "${ARG_FEATURES}")
+    set(target_dir "${target_dir}-${suffix}")
+  endif()
   # The build tree links its own copy (CargoBuild.cmake says why).
   set(lib "${CMAKE_CURRENT_BINARY_DIR}/lib${ARG_LIB_NAME}.a")
   set(stamp "${CMAKE_CURRENT_BINARY_DIR}/${target}.cargo-stamp")
@@ -86,7 +91,7 @@ function(rvc_cargo_staticlib target)
     COMMAND "${FLOCK_EXECUTABLE}" "${target_dir}/.rvc-build.lock"
             "${CMAKE_COMMAND}" "-DTARGET_DIR=${target_dir}" "-DMANIFEST_DIR=${manifest_dir}"
             "-DPACKAGE=${package}" "-DCARGO=${CARGO_EXECUTABLE}" "-DJOBS=${RVC_CARGO_JOBS}"
-            "-DLIB_NAME=${ARG_LIB_NAME}" "-DCOPY_TO=${lib}" -P "${PROJECT_SOURCE_DIR}/cmake/CargoBuild.cmake"
+            "-DLIB_NAME=${ARG_LIB_NAME}" "-DCOPY_TO=${lib}" "-DFEATURES=${ARG_FEATURES}" -P "${PROJECT_SOURCE_DIR}/cmake/CargoBuild.cmake"
     COMMAND "${CMAKE_COMMAND}" -E touch "${stamp}"
     DEPENDS ${sources} "${manifest_dir}/Cargo.toml" "${manifest_dir}/Cargo.lock"
             "${PROJECT_SOURCE_DIR}/cmake/CargoBuild.cmake" "${PROJECT_SOURCE_DIR}/cmake/CargoClaim.cmake"

@@ -15,9 +15,13 @@ foreach(var TARGET_DIR MANIFEST_DIR PACKAGE CARGO JOBS LIB_NAME COPY_TO)
   endif()
 endforeach()
 include("${CMAKE_CURRENT_LIST_DIR}/CargoClaim.cmake")
+set(feature_args "")
+if(FEATURES)
+  set(feature_args --features "${FEATURES}")
+endif()
 execute_process(
   COMMAND "${CMAKE_COMMAND}" -E env "CARGO_TARGET_DIR=${TARGET_DIR}" "CARGO_BUILD_JOBS=${JOBS}"
-          "${CARGO}" build --locked --release -j ${JOBS} --manifest-path "${MANIFEST_DIR}/Cargo.toml"
+          "${CARGO}" build --locked --release -j ${JOBS} --manifest-path "${MANIFEST_DIR}/Cargo.toml" ${feature_args}
   WORKING_DIRECTORY "${MANIFEST_DIR}"
   RESULT_VARIABLE rc)
 if(NOT rc EQUAL 0)

@@ -117,7 +117,11 @@ const foreign = [];  // requests to anything but the dashboard
 // `rvc dashboard` on port 0; resolves to [process, port] once it says where it serves.
 function startDashboard(dbPath) {
   // From the database's directory, so the page shows sqlite:results.db as a user would type it.
-  const proc = spawn(RVC, ['dashboard', '--db', `sqlite:${path.basename(dbPath)}`, '--listen', '127.0.0.1:0', '--poll', '0.1'],
+  // --silent-after 45: the live run's last counters were written when the database was built; a
+  // browser that took over 10 s to start on a loaded machine saw it as silent (CI, 2026-11-28). The
+  // dead run below is 60 s old.
+  const proc = spawn(RVC, ['dashboard', '--db', `sqlite:${path.basename(dbPath)}`, '--listen', '127.0.0.1:0', '--poll', '0.1',
+                           '--silent-after', '45'],
                      { cwd: path.dirname(dbPath), stdio: ['ignore', 'ignore', 'pipe'] });
   return new Promise((resolve, reject) => {
     let err = '';
@@ -282,7 +286,7 @@ test('an empty database: the first run appears and opens by itself', async () =>
 });
 
 test('a run whose monitor died without an end is marked silent', async () => {
-  // Started a minute ago, no end and no counters since: rvc dashboard says "silent" (--silent-after 10).
+  // Started a minute ago, no end and no counters since: rvc dashboard says "silent" (--silent-after 45).
   sql(db, [['INSERT INTO runs (run, command, inputs, time_model, started_at) VALUES (?,?,?,?,?)',
             ['r-dead', 'rvc monitor', '[]', 'discrete', Date.now() / 1000 - 60]]]);
   const marker = page.locator('#runs li[data-run="r-dead"] .live-marker.silent');
