@@ -268,6 +268,8 @@ def main():
                     help="also run dds-1pkt (--no-dds-write-batch) and zenoh-queue (--handoff queue), the old "
                          "defaults, on the first N files (0: none)")
     ap.add_argument("--latency-seconds", type=float, default=None, help="per latency run (default 5, quick 1)")
+    ap.add_argument("--latency-rounds", type=int, default=3,
+                    help="latency runs per transport and rate, interleaved; the tables give the medians (default 3)")
     ap.add_argument("--batch", type=int, default=1, help="events per published sample (rvc replay --batch)")
     ap.add_argument("--build", default=os.path.join(ROOT, "build", "release"))
     ap.add_argument("--no-docs", action="store_true")
@@ -351,25 +353,35 @@ def main():
         lat_transports = [t for t in transports if t in ("dds", "zenoh-p2p", "zenoh-queue")]
         if "zenoh-p2p" in lat_transports and "zenoh-queue" not in lat_transports and args.cause_files:
             lat_transports.insert(lat_transports.index("zenoh-p2p") + 1, "zenoh-queue")
-        for t in lat_transports:
-            for rate, count in trace_rates:
-                trace = os.path.join(data, f"latency_{count}.jsonl")
-                if not os.path.exists(trace):
-                    subprocess.run([rvc, "timescales", "RecurGLB", "--ubound", "10", "--duration", str(count),
-                                    "--seed", "3", "-o", trace], check=True)
-                setup_out = "dds:/rv/bench_verdicts" if t.startswith("dds") else "zenoh:rv/bench_verdicts"
-                stats, sent, _ = run_pair(ctx, t, "once[:10]{p}", trace, extra_mon=["--all"],
-                                          extra_rep=["--rate", str(rate), "--latency-from", setup_out],
-                                          output=setup_out)
-                lat = sent.get("latency_us", {})
-                lsize = int(round(mean_line_bytes(trace)))
-                ping = ddsperf_ping(ctx, rate, lsize, lat_secs + 1) if t.startswith("dds") \
-                    else zenoh_ping(ctx, rate, lsize, lat_secs + 1)
-                latency.append(dict(transport=t, rate=rate, messages=count, back=sent.get("verdicts_back", 0),
-                                    rv=lat, ping=ping, load=loadavg()))
-                print(f"latency {t:10s} {rate:>6d}/s: rv p50 {lat.get('p50', 0):7.1f} p99 {lat.get('p99', 0):8.1f} us"
-                      f" | ping RTT p50 {ping.get('p50', 0):7.1f} p99 {ping.get('p99', 0):8.1f} us "
-                      f"({sent.get('verdicts_back', 0)}/{count} back)", flush=True)
+        runs = {}  # (transport, rate) -> [(rv, ping, back, load)], one per round, rounds interleaved
+        for rnd, t, (rate, count) in [(r, t, tr) for r in range(args.latency_rounds) for t in lat_transports
+                                      for tr in trace_rates]:
+            trace = os.path.join(data, f"latency_{count}.jsonl")
+            if not os.path.exists(trace):
+                subprocess.run([rvc, "timescales", "RecurGLB", "--ubound", "10", "--duration", str(count),
+                                "--seed", "3", "-o", trace], check=True)
+            setup_out = "dds:/rv/bench_verdicts" if t.startswith("dds") else "zenoh:rv/bench_verdicts"
+            stats, sent, _ = run_pair(ctx, t, "once[:10]{p}", trace, extra_mon=["--all"],
+                                      extra_rep=["--rate", str(rate), "--latency-from", setup_out],
+                                      output=setup_out)
+            lat = sent.get("latency_us", {})
+            lsize = int(round(mean_line_bytes(trace)))
+            ping = ddsperf_ping(ctx, rate, lsize, lat_secs + 1) if t.startswith("dds") \
+                else zenoh_ping(ctx, rate, lsize, lat_secs + 1)
+            runs.setdefault((t, rate, count), []).append((lat, ping, sent.get("verdicts_back", 0), loadavg()))
+            print(f"latency [{rnd + 1}/{args.latency_rounds}] {t:10s} {rate:>6d}/s: rv p50 {lat.get('p50', 0):7.1f} p99 {lat.get('p99', 0):8.1f} us"
+                  f" | ping RTT p50 {ping.get('p50', 0):7.1f} p99 {ping.get('p99', 0):8.1f} us "
+                  f"({sent.get('verdicts_back', 0)}/{count} back)", flush=True)
+
+        # Each figure: the median over the rounds (rv and ping alike); "back": verdicts over all rounds.
+        for (t, rate, count), rs in runs.items():
+            pick = lambda which, k: med([r[which].get(k, float("nan")) for r in rs])  # noqa: E731
+            latency.append(dict(transport=t, rate=rate, messages=count * len(rs), back=sum(r[2] for r in rs),
+                                rounds=len(rs), load=med([r[3] for r in rs]),
+                                rv={k: pick(0, k) for k in ("p50", "p99", "max")},
+                                ping={k: pick(1, k) for k in ("p50", "p99")} if all(r[1] for r in rs) else {},
+                                rv_p50s=[r[0].get("p50") for r in rs], ping_p50s=[r[1].get("p50") for r in rs],
+                                rv_p99s=[r[0].get("p99") for r in rs], ping_p99s=[r[1].get("p99") for r in rs]))
 
     elapsed = time.time() - t_start
     cmd = "python3 bench/network_bench.py" + (" " + " ".join(sys.argv[1:]) if sys.argv[1:] else "")
@@ -474,21 +486,32 @@ def render(rows, base, latency, transports, args, size, elapsed, cmd):
                            f"{floor:.2f} | {med([x['load'] for x in base[k]]):.1f} |")
     if latency:
         out.append("")
+        rounds = max(l.get("rounds", 1) for l in latency)
         out.append("Latency, publish → verdict received back (`rvc monitor --all`; a round trip) beside the "
                    "transport's own ping round trip at the same rate and size (DDS: ddsperf ping/pong, which prints "
-                   "RTT/2, doubled; Zenoh: rvc perf ping/pong, doubled), microseconds:\n")
+                   "RTT/2, doubled; Zenoh: rvc perf ping/pong, doubled), microseconds; each figure the median of "
+                   f"{rounds} interleaved rounds (rv run, then its ping run), p50 and p99 of each round in the last "
+                   "columns:\n")
         out.append("| transport | rate (msg/s) | verdicts back | rv p50 | ping p50 | rv − ping p50 | rv p99 | ping p99 | "
-                   "rv − ping p99 | rv max | load |")
-        out.append("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+                   "rv − ping p99 | rv max | load | rounds: rv / ping p50 | rounds: rv / ping p99 |")
+        out.append("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---|")
         for l in latency:
             rv, pg = l["rv"], l["ping"]
             out.append(f"| {l['transport']} | {l['rate']} | {l['back']}/{l['messages']} | {rv.get('p50', 0):.0f} | "
                        f"{pg.get('p50', float('nan')):.0f} | {rv.get('p50', 0) - pg.get('p50', float('nan')):+.0f} | "
                        f"{rv.get('p99', 0):.0f} | {pg.get('p99', float('nan')):.0f} | "
                        f"{rv.get('p99', 0) - pg.get('p99', float('nan')):+.0f} | {rv.get('max', 0):.0f} | "
-                       f"{l['load']:.1f} |")
+                       f"{l['load']:.1f} | {each(l.get('rv_p50s'), l.get('ping_p50s'))} | "
+                       f"{each(l.get('rv_p99s'), l.get('ping_p99s'))} |")
     out += targets(rows, base, latency, transports, args)
     return "\n".join(out) + "\n"
+
+
+def each(rv, ping):
+    """Each round's rv / ping figure: '106/73, 98/70, ...'."""
+    if not rv:
+        return ""
+    return ", ".join(f"{a:.0f}/{b:.0f}" if a is not None and b is not None else "?" for a, b in zip(rv, ping or []))
 
 
 def targets(rows, base, latency, transports, args):

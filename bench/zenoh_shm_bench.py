@@ -16,7 +16,8 @@ Per payload size, interleaved (the same load for both builds), `--reps` times, m
   carry the payload (a JSON string field beside the checked one), time from first publish to last
   verdict, 0 lost asserted by the counters.
 Whether shared memory was used is observed, not assumed: the /dev/shm/*.zenoh segments present while
-the SHM build's pair runs (none appear for the default build).
+the SHM build's pair runs (none appear for the default build). The run has a /dev/shm of its own (a
+tmpfs in a private mount namespace, as root): Zenoh's segments never land in the host's.
 
 Writes bench/results/zenoh-shm.{json,md} and docs/img/zenoh-shm.png, and the table into docs/zenoh.md
 between the shm markers. A benchmark, not a test: it asserts nothing about speed. Loopback only.
@@ -25,6 +26,7 @@ import argparse
 import glob
 import json
 import os
+import shutil
 import socket
 import statistics
 import subprocess
@@ -139,6 +141,21 @@ def monitor_path(rvc, trace, n, tmp, tag):
     return dict(ms=secs * 1e3, per_s=n / secs, lost=lost, mon_us=cpu_of(tm) / n * 1e6)
 
 
+def private_dev_shm():
+    """Runs this benchmark in its own mount namespace with a fresh tmpfs on /dev/shm (re-executing
+    itself under unshare): Zenoh leaves the last exiting process's segments there, and its orphan
+    cleanup removes other Zenoh processes' dead segments, neither of which may touch the host's
+    /dev/shm. The namespace's tmpfs goes away with it."""
+    if os.environ.get("RVC_SHM_BENCH_NS") == "1":
+        return
+    if os.geteuid() != 0 or not shutil.which("unshare"):
+        sys.exit("zenoh_shm_bench.py runs in a private /dev/shm (unshare --mount, as root): not possible here")
+    script = 'mount -t tmpfs -o size=512m,mode=1777 rvc-shm-bench /dev/shm && exec "$@"'
+    env = dict(os.environ, RVC_SHM_BENCH_NS="1")
+    os.execvpe("unshare", ["unshare", "--mount", "--propagation", "private", "sh", "-c", script, "sh",
+                           sys.executable, os.path.abspath(__file__), *sys.argv[1:]], env)
+
+
 def ensure_shm_build(build):
     rvc = os.path.join(build, "rvc")
     if os.path.exists(rvc):
@@ -175,6 +192,7 @@ def main():
     builds = {"default": os.path.join(args.default_build, "rvc"), "shm": ensure_shm_build(args.shm_build)}
     if not os.path.exists(builds["default"]):
         sys.exit(f"{builds['default']} missing: build rvc first (scripts/build.sh)")
+    private_dev_shm()
     tmp = tempfile.mkdtemp(prefix="rvc-shm-bench-")
     t0 = time.time()
     res = {b: {s: dict(pair=[], ping=[], mon=[]) for s in sizes} for b in builds}
