@@ -338,6 +338,9 @@ class SilentSource final : public transport::Source {
   }
   bool seen_before_resume = false;
   bool after_clock = false;  // also wait until the ClockSource sent everything
+  // The loop may check on this source's thread (LoopOptions::Handoff::Inline, Zenoh's case).
+  bool may_block = false;
+  bool handler_may_block() const override { return may_block; }
 
  private:
   Collected& c_;
@@ -356,7 +359,8 @@ struct LoopRun {
 };
 
 void run_loop(LoopRun& r, const std::string& spec, ClockKind clock, std::vector<std::string> before,
-              const std::string& awaited, std::vector<std::string> after, double tick_bound = 0) {
+              const std::string& awaited, std::vector<std::string> after, double tick_bound = 0,
+              bool inline_handoff = false) {
   std::vector<std::unique_ptr<transport::Sink>> sinks;
   sinks.push_back(std::make_unique<CollectingSink>(r.collected));
   VerdictOutputs outputs(std::move(sinks), false);
@@ -374,6 +378,7 @@ void run_loop(LoopRun& r, const std::string& spec, ClockKind clock, std::vector<
   // verdict ends the wait, and 5 s only bound a failing run).
   SilentSource source(r.collected, std::move(before), awaited, std::move(after),
                       clock == ClockKind::Off || awaited == "never" ? 500ms : 5s);
+  source.may_block = inline_handoff;
   loop.run(source);
   r.seen_before_resume = source.seen_before_resume;
   r.ticks = loop.ticks();
@@ -393,6 +398,39 @@ TEST(MonitorLoopClock, ReportsAFallDuringSilenceAtItsInstant) {
   EXPECT_LE(r.ticks, 6u);
   EXPECT_NE(r.stats.find(R"("clock":"stamps")"), std::string::npos) << r.stats;
   EXPECT_NE(r.stats.find(R"("late_to_clock":0)"), std::string::npos) << r.stats;
+}
+
+// The same on the inline hand-off (the source's thread checks, the loop's
+// thread ticks, both under the engine's lock): the fall is still published
+// at its instant during the silence, and the counters say which ran.
+TEST(MonitorLoopClock, ReportsAFallDuringSilenceInline) {
+  LoopRun r;
+  run_loop(r, "once[0:0.125]{alive}", ClockKind::Stamps,
+           {R"({"time":0.25,"alive":true})", R"({"time":0.5,"alive":false})"},
+           R"({"time":0.625,"property":"p","value":false})", {R"({"time":5,"alive":true})"}, 0, true);
+  EXPECT_TRUE(r.seen_before_resume) << "the fall at 0.625 was not published while the source was silent";
+  EXPECT_LE(r.ticks, 6u);
+  EXPECT_NE(r.stats.find(R"("handoff":"inline")"), std::string::npos) << r.stats;
+  EXPECT_NE(r.stats.find(R"("checked":3)"), std::string::npos) << r.stats;
+  EXPECT_TRUE(r.collected.has(R"({"time":5,"property":"p","value":true})"));
+}
+
+TEST(MonitorLoopClock, CountsMessagesLateToTheClockInline) {
+  LoopRun r;
+  run_loop(r, "once[0:0.125]{alive}", ClockKind::Stamps,
+           {R"({"time":0.25,"alive":true})", R"({"time":0.5,"alive":false})"},
+           R"({"time":0.625,"property":"p","value":false})", {R"({"time":0.6,"alive":true})"}, 0, true);
+  EXPECT_TRUE(r.seen_before_resume);
+  EXPECT_NE(r.stats.find(R"("late_to_clock":1)"), std::string::npos) << r.stats;
+  EXPECT_NE(r.stats.find(R"("handoff":"inline")"), std::string::npos) << r.stats;
+}
+
+// A source whose thread must not block gets the queue even when inline is
+// asked for by default (auto): the counters say "queue".
+TEST(MonitorLoopClock, AutoKeepsTheQueueForSourcesThatMustNotBlock) {
+  LoopRun r;
+  run_loop(r, "{alive}", ClockKind::Off, {R"({"time":0.25,"alive":true})"}, "never", {});
+  EXPECT_NE(r.stats.find(R"("handoff":"queue")"), std::string::npos) << r.stats;
 }
 
 // Without a clock the fall is reported only once the next message comes.
@@ -447,6 +485,8 @@ class ClockSource final : public transport::Source {
   ClockSource(Collected& c, std::string start_after, std::vector<double> times)
       : c_(c), start_after_(std::move(start_after)), times_(std::move(times)) {}
   ~ClockSource() override { stop(); }
+  bool may_block = false;  // as SilentSource's
+  bool handler_may_block() const override { return may_block; }
   void start(transport::FrameHandler handler) override {
     thread_ = std::thread([this, handler] {
       {
@@ -487,7 +527,7 @@ class ClockSource final : public transport::Source {
 // fall of once[0:2]{alive} at 3.0 (by hand: alive holds on [0.5, 1.0), so
 // the window [t-2, t] holds a true instant until t = 3.0) is published
 // while the data source is still silent; /clock is no checked input.
-TEST(MonitorLoopClock, RosClockTicksAsClockPassesDeadlines) {
+void ros_clock_run(bool inline_handoff) {
   Collected collected;
   std::vector<std::unique_ptr<transport::Sink>> sinks;
   sinks.push_back(std::make_unique<CollectingSink>(collected));
@@ -514,6 +554,7 @@ TEST(MonitorLoopClock, RosClockTicksAsClockPassesDeadlines) {
   // The data ends after every /clock message (counted below), not while the
   // clock thread still sends: on a slow run (TSan under load) 16 of 22 were.
   data.after_clock = true;
+  data.may_block = clock.may_block = inline_handoff;
   loop.run(data);
   EXPECT_TRUE(data.seen_before_resume) << "the fall at 3.0 was not published while only /clock moved";
   const std::string stats = loop.final_stats();
@@ -522,7 +563,12 @@ TEST(MonitorLoopClock, RosClockTicksAsClockPassesDeadlines) {
   EXPECT_NE(stats.find(R"("received":3)"), std::string::npos) << stats;
   EXPECT_NE(stats.find(R"("clock_messages":22)"), std::string::npos) << stats;
   EXPECT_NE(stats.find(R"("clock_backwards":1)"), std::string::npos) << stats;
+  EXPECT_NE(stats.find(inline_handoff ? R"("handoff":"inline")" : R"("handoff":"queue")"), std::string::npos) << stats;
 }
+
+TEST(MonitorLoopClock, RosClockTicksAsClockPassesDeadlines) { ros_clock_run(false); }
+// Both sources' threads check, in turn, under the engine's lock.
+TEST(MonitorLoopClock, RosClockTicksAsClockPassesDeadlinesInline) { ros_clock_run(true); }
 
 }  // namespace
 }  // namespace rvc::runtime
