@@ -15,6 +15,7 @@
 #include "runtime/pipeline.hpp"
 #include "spec/parser.hpp"
 #include "spec/spec_error.hpp"
+#include "spec_soup.hpp"
 
 namespace rvc {
 namespace {
@@ -63,11 +64,15 @@ struct Out {
   runtime::PipelineStats stats;
 };
 
-Out run(const std::string& spec, const std::vector<std::string>& msgs, bool strict = false, bool robust = false) {
+// Feeds `msgs` (JSON) to one property; with `type`, each message goes in as
+// its CDR sample of that type instead (the typed decoder's path).
+Out run(const std::string& spec, const std::vector<std::string>& msgs, bool strict = false, bool robust = false,
+        const msg::MessageType* type = nullptr) {
   runtime::PipelineOptions o;
   o.emit_all = true;
   o.strict = strict;
   o.robustness = robust;
+  o.type = type;
   o.max_reported = 0;
   Out out;
   runtime::Pipeline p({{"p", spec}}, o, [&](const engine::Verdict& v) {
@@ -75,7 +80,13 @@ Out run(const std::string& spec, const std::vector<std::string>& msgs, bool stri
     out.margins.push_back(v.robustness);
   });
   uint64_t seq = 0;
-  for (const auto& m : msgs) p.feed(m, ++seq);
+  std::string sample, error;
+  for (const auto& m : msgs) {
+    if (type) {
+      EXPECT_TRUE(io::json_to_cdr(*type, m, sample, error)) << error;
+    }
+    p.feed(type ? sample : m, ++seq);
+  }
   out.stats = p.stats();
   return out;
 }
@@ -129,28 +140,6 @@ TEST(ArrayQuantifiers, ElementsWithoutAValue) {
 
 // Typed (CDR) samples of the same values give the JSON trace's verdicts,
 // margins and warnings (the CDR decoder folds elements as the JSON one does).
-Out run_typed(const std::string& spec, const std::vector<std::string>& msgs, const msg::MessageType& type,
-              bool robust) {
-  runtime::PipelineOptions o;
-  o.emit_all = true;
-  o.type = &type;
-  o.robustness = robust;
-  o.max_reported = 0;
-  Out out;
-  runtime::Pipeline p({{"p", spec}}, o, [&](const engine::Verdict& v) {
-    out.verdicts.push_back(v.value ? "T" : "F");
-    out.margins.push_back(v.robustness);
-  });
-  uint64_t seq = 0;
-  for (const auto& m : msgs) {
-    std::string sample, error;
-    EXPECT_TRUE(io::json_to_cdr(type, m, sample, error)) << error;
-    p.feed(sample, ++seq);
-  }
-  out.stats = p.stats();
-  return out;
-}
-
 TEST(ArrayQuantifiers, TypedEqualsJson) {
   msg::TypeRegistry reg;
   reg.add_definition("t_msgs/msg/Obj", "float64 distance\nstring name\n", "test");
@@ -168,7 +157,7 @@ TEST(ArrayQuantifiers, TypedEqualsJson) {
                            "{any(objects[*].name > 1)}"}) {  // the last: of the wrong type (warnings)
     for (bool robust : {false, true}) {
       const Out json = run(spec, msgs, false, robust);
-      const Out typed = run_typed(spec, msgs, type, robust);
+      const Out typed = run(spec, msgs, false, robust, &type);
       EXPECT_EQ(typed.verdicts, json.verdicts) << spec;
       EXPECT_EQ(typed.margins, json.margins) << spec;
       EXPECT_EQ(typed.stats.warnings, json.stats.warnings) << spec;
@@ -213,32 +202,13 @@ TEST(ArrayQuantifiers, TokenSoupParsesToAFixedPointOrASpecError) {
       }
       if (rng() % 2) s = s.substr(0, rng() % (s.size() + 1));
     } else {
-      for (int k = 1 + static_cast<int>(rng() % 10); k > 0; --k) {
-        s += tokens[rng() % (sizeof tokens / sizeof *tokens)];
-        if (rng() % 2) s += ' ';
-      }
+      s = test::token_soup(rng, tokens, 10);
     }
-    spec::NodePtr ast;
-    try {
-      ast = spec::parse(s);
-    } catch (const spec::SpecError&) {
-      continue;
-    }
-    ++parsed;
-    const std::string printed = spec::to_string(*ast);
-    EXPECT_EQ(spec::to_string(*spec::parse(printed)), printed) << s;
-    runtime::PipelineOptions po;
-    po.robustness = i % 2 == 1;
-    testing::internal::CaptureStderr();
-    try {
-      runtime::Pipeline p({{"p", s}}, po, nullptr);
-      uint64_t n = 0;
-      for (const char* line : {R"({"a": [1, 3], "o": [{"d": 1}, {"d": "s"}], "x": 1})", R"({"a": 2, "o": []})",
-                               R"({"a": [], "o": [{"e": 1}, null]})", R"({"a": [true, null, {}], "o": [{"d": 0}]})"})
-        p.feed(line, ++n);
-    } catch (const std::exception&) {  // refused (e.g. a[*] with a[0]), never a crash
-    }
-    testing::internal::GetCapturedStderr();
+    // Accepted specs run on a short trace (robustness every other time).
+    parsed += test::accepted_round_trips_and_runs(
+        s, i % 2 == 1,
+        {R"({"a": [1, 3], "o": [{"d": 1}, {"d": "s"}], "x": 1})", R"({"a": 2, "o": []})",
+         R"({"a": [], "o": [{"e": 1}, null]})", R"({"a": [true, null, {}], "o": [{"d": 0}]})"});
   }
   EXPECT_GT(parsed, 500);
 }

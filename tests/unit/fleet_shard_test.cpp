@@ -39,7 +39,9 @@ TEST(Rendezvous, OnlyTheDepartedMembersShardsMoveAndTheSpreadIsEven) {
     const std::string shard = "fleet/v" + std::to_string(i);
     const std::string before = owner_of(shard, three), after = owner_of(shard, two);
     ++load[before];
-    if (before != "m2") EXPECT_EQ(before, after) << shard;  // a survivor keeps what it had
+    if (before != "m2") {
+      EXPECT_EQ(before, after) << shard;  // a survivor keeps what it had
+    }
     moved += before != after;
   }
   EXPECT_EQ(moved, load["m2"]);
