@@ -269,34 +269,32 @@ QueryResult rows_after(Database& db, const char* columns, const char* table, con
 const char* const kVerdictColumns = "id, property, time, value, wall, known_at";
 const char* const kViolationColumns = "id, property, time, wall, witness, explanation, known_at";
 
-// A database written by an rvc before explanations were stored has no such
-// column, and the dashboard reads databases as they are (it never migrates
-// one): its violations have null explanations.
-const char* violation_columns(Database& db) {
+// Whether `table` has `column` (a database written by an older rvc may not;
+// the dashboard reads databases as they are and never migrates one). A lost
+// connection is not an answer: it is thrown.
+bool has_column(Database& db, const char* table, const char* column) {
   try {
-    db.query("SELECT explanation FROM violations LIMIT 0");
+    db.query(std::string("SELECT ") + column + " FROM " + table + " LIMIT 0");
+    return true;
   } catch (const store::DbError& e) {
     if (e.connection_lost()) throw;
-    return "id, property, time, wall, witness, NULL AS explanation, NULL AS known_at";
-  }
-  try {
-    db.query("SELECT known_at FROM violations LIMIT 0");
-    return kViolationColumns;
-  } catch (const store::DbError& e) {
-    if (e.connection_lost()) throw;
-    return "id, property, time, wall, witness, explanation, NULL AS known_at";
+    return false;
   }
 }
 
-// The same for verdicts: known_at (bounded future) came later.
+// Violations: explanations came later, then known_at (bounded future); a
+// missing column reads as null.
+const char* violation_columns(Database& db) {
+  if (!has_column(db, "violations", "explanation"))
+    return "id, property, time, wall, witness, NULL AS explanation, NULL AS known_at";
+  if (!has_column(db, "violations", "known_at"))
+    return "id, property, time, wall, witness, explanation, NULL AS known_at";
+  return kViolationColumns;
+}
+
+// The same for verdicts: known_at came later.
 const char* verdict_columns(Database& db) {
-  try {
-    db.query("SELECT known_at FROM verdicts LIMIT 0");
-    return kVerdictColumns;
-  } catch (const store::DbError& e) {
-    if (e.connection_lost()) throw;
-    return "id, property, time, value, wall, NULL AS known_at";
-  }
+  return has_column(db, "verdicts", "known_at") ? kVerdictColumns : "id, property, time, value, wall, NULL AS known_at";
 }
 const char* const kCounterColumns = "id, wall, counters";
 
