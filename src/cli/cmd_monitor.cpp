@@ -549,10 +549,14 @@ struct MonitorCommand {
     }
     if (!bag)
       if (int status = refuse_input_copies(outputs, inputs.at(0))) return status;
-    if (handoff == "inline")  // the receive thread checks: only a transport whose callbacks may block
+    if (handoff == "inline") {  // the receive thread checks: only a transport whose callbacks may block
+      std::vector<std::string> uris;
       for (const std::string& in : inputs) {
         const auto eq = in.find('=');
-        const std::string uri = SyncFlags::named(inputs) && eq != std::string::npos ? in.substr(eq + 1) : in;
+        uris.push_back(SyncFlags::named(inputs) && eq != std::string::npos ? in.substr(eq + 1) : in);
+      }
+      if (clock.clock.rfind("ros=", 0) == 0) uris.push_back(clock.clock.substr(4));  // the /clock input too
+      for (const std::string& uri : uris) {
         const std::string scheme = transport::scheme_of(uri);
         if ((scheme != "zenoh" && scheme != "rmw_zenoh") || group.given()) {
           std::fprintf(stderr, "rvc: --handoff inline checks each message on its transport's receive thread, which "
@@ -561,6 +565,7 @@ struct MonitorCommand {
           return kUsage;
         }
       }
+    }
     if (SyncFlags::named(inputs)) return run_synced();
     if (!bag && refuse_binary_file(inputs.at(0))) return kUsage;
     if (!bag && (!sync.stamps.empty() || app->count("--sync") || app->count("--pivot") || app->count("--lower-bound"))) {

@@ -143,3 +143,7 @@ def test_inline_needs_a_zenoh_input(rvc, tmp_path):
                            capture_output=True, text=True, timeout=30)
         assert r.returncode == 2, r.stderr
         assert "--handoff inline" in r.stderr and "use --handoff queue or auto" in r.stderr, r.stderr
+    # A Zenoh input with a DDS /clock: that input's thread would check too.
+    r = subprocess.run([rvc, "monitor", "--spec", "{p}", "--input", "zenoh:rvc_test/x", "--clock", "ros=dds:/clock",
+                        "--handoff", "inline"], capture_output=True, text=True, timeout=30)
+    assert r.returncode == 2 and "not dds:/clock" in r.stderr, r.stderr
