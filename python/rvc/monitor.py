@@ -67,7 +67,8 @@ class Monitor:
             for v in m.update(msg):
                 print(v.property, v.time, v.value)
 
-    dense: time from each message's `time_field` (seconds), verdict changes at their exact times;
+    dense: time from each message's `time_field` (seconds, exact to the nanosecond), verdict changes at
+    their exact times; the timeline starts at the first message (origin="zero": at time 0, Reelay's rule);
     else one step per message. robustness: margins instead of Booleans. explain: a violation's
     verdict says why. all: a verdict at every step (discrete), not only changes.
     type: messages are CDR samples of this ROS 2 type (update_cdr), decoded by rvc's type
@@ -76,10 +77,10 @@ class Monitor:
 
     def __init__(self, properties: Properties, *, dense: bool = False, robustness: bool = False,
                  explain: bool = False, all: bool = False, time_field: str = "time", type: Optional[str] = None,
-                 msg_path: Sequence[str] = (), max_data_values: int = 100000):
+                 msg_path: Sequence[str] = (), max_data_values: int = 100000, origin: str = "first"):
         self._args = dict(properties=_properties(properties), dense=dense, robustness=robustness, explain=explain,
                           emit_all=all, time_field=time_field, msg_paths=[os.fspath(p) for p in msg_path],
-                          max_data_values=max_data_values)
+                          max_data_values=max_data_values, origin=origin)
         self._type = type
         self._session = _rvc.Session(type=type or "", **self._args)
         self._fed = False

@@ -15,6 +15,7 @@ SessionOptions options(bool dense, bool robustness, bool every_step) {
   o.dense = dense;
   o.robustness = robustness;
   o.emit_all = every_step;
+  o.origin_zero = true;  // Reelay's timeline starts at 0 (docs/python.md)
   return o;
 }
 

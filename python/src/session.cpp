@@ -14,6 +14,7 @@ Session::Session(std::vector<engine::PropertySpec> properties, SessionOptions op
   po.robustness = options_.robustness;
   po.explain = options_.explain;
   po.max_data_values = options_.max_data_values;
+  po.origin = options_.origin_zero ? runtime::Origin::Zero : runtime::Origin::First;
   po.on_report = [this](const std::string& text) { on_report(text); };
   if (!options_.type.empty()) {
     for (const auto& dir : options_.msg_paths) registry_.add_search_path(dir);

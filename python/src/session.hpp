@@ -35,6 +35,9 @@ struct SessionOptions {
   std::string type;                    // ROS 2 type of CDR samples; empty: dict / JSON messages
   std::vector<std::string> msg_paths;  // folders of .msg / .idl definitions for `type`
   uint32_t max_data_values = 100000;
+  // Dense time: where the timeline starts (runtime/engine_time.hpp). Reelay's
+  // drop-in API keeps Reelay's 0; rvc.Monitor starts at the first message.
+  bool origin_zero = false;
 };
 
 // A message rvc refused (its text names why and where); Python's ValueError.

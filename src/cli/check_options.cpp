@@ -9,6 +9,12 @@ void CheckOptions::add_to(CLI::App& app) {
   app.add_option("--spec,-s", specs, "A property in Rye syntax (repeatable; named p1, p2, ...)")->allow_extra_args(false);
   app.add_option("--properties,-p", properties_file, "YAML/JSON file of named properties")->check(CLI::ExistingFile);
   app.add_flag("--dense", dense, "Dense time: messages carry a time field; values hold until the next message");
+  app.add_option("--origin", origin,
+                 "Dense time: where the timeline starts. first (default): at the first message, nothing is said "
+                 "about instants before it; zero: at time 0, with every field unseen until the first message "
+                 "(Reelay's rule)")
+      ->check(CLI::IsMember({"first", "zero"}))
+      ->capture_default_str();
   app.add_flag("--all", all, "Report the verdict at every step, not only changes");
   app.add_flag("--robustness", robustness,
                "Report robustness values (Reelay's quantitative semantics: how far from changing the verdict; "
@@ -83,6 +89,7 @@ PipelineOptions CheckOptions::pipeline_options() const {
   o.explain = explain;
   o.max_data_values = max_data_values;
   o.max_message_size = max_message_size;
+  o.origin = origin == "zero" ? runtime::Origin::Zero : runtime::Origin::First;
   return o;
 }
 

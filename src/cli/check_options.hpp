@@ -17,6 +17,7 @@ struct CheckOptions {
   std::vector<std::string> specs;
   std::string properties_file;
   bool dense = false;
+  std::string origin = "first";  // --origin first|zero (dense time)
   bool all = false;
   bool strict = false;
   std::string time_field = "time";

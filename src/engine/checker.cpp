@@ -6,6 +6,7 @@
 #include <limits>
 #include <stdexcept>
 
+#include "spec/exact_time.hpp"
 #include "spec/parser.hpp"
 #include "spec/pastify.hpp"
 #include "spec/spec_error.hpp"
@@ -30,12 +31,22 @@ void Checker::enable_explain() {
   for (auto& m : dense_data_) m.enable_explain();
 }
 
+namespace {
+void in_nanoseconds(spec::Node& n);
+}  // namespace
+
 void Checker::add_property(const PropertySpec& property) {
   spec::ParseOptions options;
   options.dense = model_ == TimeModel::Dense;
   options.robustness = robustness_;
   spec::NodePtr ast = spec::parse(property.spec, options);
+  if (nanoseconds_) in_nanoseconds(*ast);
   const double h = spec::horizon(*ast);
+  if (nanoseconds_ && h > static_cast<double>(spec::kExactSpanNs))
+    throw spec::SpecError("the future horizon is " + spec::seconds_text(static_cast<int64_t>(std::min(h, 9e18))) +
+                              " s: dense time is exact to the nanosecond up to 9007199.254740992 s (2^53 ns, about "
+                              "104 days), and a horizon must lie within it",
+                          property.spec, 1);
   if (spec::has_future(*ast)) ast = pastified(*ast, h, property.spec);  // h may be 0: until[0:0]
   Program program = compile(*ast, atoms_, model_, property.spec);
   if (program.has_data()) {
@@ -81,6 +92,17 @@ void Checker::add_property(const PropertySpec& property) {
   }
   add_name(property.name, h);
 }
+
+namespace {
+// Dense monitors run in nanoseconds: the formula's bounds become the exact
+// nanoseconds the parser read from their text.
+void in_nanoseconds(spec::Node& n) {
+  n.bounds.lo = n.bounds.lo_ns;
+  n.bounds.hi = n.bounds.hi_ns;
+  if (n.left) in_nanoseconds(*n.left);
+  if (n.right) in_nanoseconds(*n.right);
+}
+}  // namespace
 
 namespace {
 bool has_quantifier(const spec::Node& n) {
@@ -142,10 +164,10 @@ bool Checker::refer(size_t i, double& time, double& known, double value) {
     stash_[i] = std::numeric_limits<double>::quiet_NaN();
     known = finished_ ? std::min(time, end_known_) : time;  // settled: known when the stream ended
     time -= d;
-    // Dense time: 1.2 - 1 is 0.19999999999999996; stamps are written with
-    // at most nanoseconds, so a difference within rounding error of a whole
-    // nanosecond is that nanosecond.
-    if (model_ == TimeModel::Dense) {
+    // Dense time in seconds (not the runtime's nanoseconds, which are exact):
+    // 1.2 - 1 is 0.19999999999999996; a difference within rounding error of
+    // a whole nanosecond is that nanosecond.
+    if (model_ == TimeModel::Dense && !nanoseconds_) {
       const double ns = std::round(time * 1e9) / 1e9;
       if (std::abs(ns - time) <= 1e-12 * std::max(1.0, std::abs(time))) time = ns;
     }
@@ -188,9 +210,9 @@ void Checker::finish() {
   }
   // Dense time: the stream covers [0, clock). A tick at the clock (the end
   // tick of a recording) told the value at that instant too: it stays part
-  // of the stream, and the windows are cut just after it, 1e-9 (relative)
-  // later: a gap that bounds added to it do not round away.
-  const double cut = told_at_ == clock_ ? clock_ + 1e-9 * std::max(1.0, std::abs(clock_)) : clock_;
+  // of the stream, and the windows are cut just after it, 1 ns later (times
+  // are integer nanoseconds: nothing rounds away).
+  const double cut = told_at_ == clock_ ? clock_ + (nanoseconds_ ? 1 : 1e-9 * std::max(1.0, std::abs(clock_))) : clock_;
   end_ = cut;
   end_known_ = clock_;
   // Up to and with clock + delay (cut + delay may round down to it).
@@ -221,7 +243,10 @@ void Checker::emit(size_t property, double time, bool value, double known,
   if (!emit_all_ && last_[property] == static_cast<int8_t>(value)) return;
   last_[property] = static_cast<int8_t>(value);
   if (!value) ++violations_;
-  if (on_verdict_) on_verdict_(Verdict{names_[property], time, value, false, 0, explanation, known});
+  if (!on_verdict_) return;
+  Verdict v = verdict(property, time, value, known);
+  v.explanation = explanation;
+  on_verdict_(v);
 }
 
 void Checker::report_discrete(size_t i, double now) {
@@ -347,7 +372,25 @@ void Checker::emit_robust(size_t i, double time, double r, double known) {
   last_robustness_[i] = r;
   const bool holds = r > 0;
   if (!holds) ++violations_;
-  if (on_verdict_) on_verdict_(Verdict{names_[i], time, holds, true, r, nullptr, known});
+  if (!on_verdict_) return;
+  Verdict v = verdict(i, time, holds, known);
+  v.robust = true;
+  v.robustness = r;
+  on_verdict_(v);
+}
+
+Verdict Checker::verdict(size_t property, double time, bool value, double known) const {
+  Verdict v{names_[property], time, value, false, 0, nullptr, known};
+  if (!nanoseconds_) return v;
+  // Engine nanoseconds from the origin back to the instant (spec/exact_time.hpp).
+  v.exact = true;
+  v.time_ns = origin_ns_ + static_cast<int64_t>(std::llround(time));
+  v.time = static_cast<double>(v.time_ns) / 1e9;
+  if (known == known) {
+    v.known_ns = origin_ns_ + static_cast<int64_t>(std::llround(known));
+    v.known_at = static_cast<double>(v.known_ns) / 1e9;
+  }
+  return v;
 }
 
 void Checker::step_robust(double begin, double end, const double* margins) {
@@ -362,6 +405,7 @@ void Checker::step_robust(double begin, double end, const double* margins) {
 
 void Checker::step(double begin, double end, const uint8_t* atoms, const uint32_t* bound) {
   if (begin < clock_) begin = clock_;  // a tick went there already
+  if (explain_) explain::origin_ns = origin_ns_, explain::nanoseconds = nanoseconds_;  // its sentences name instants
   if (!(begin < end)) return;  // an empty segment has no value to report
   clock_ = end;
   if (!delayed_.empty() && !finished_) last_atoms_.assign(atoms, atoms + atoms_.size());
@@ -391,6 +435,7 @@ bool Checker::value_at_clock(size_t i, const uint8_t* atoms, const uint32_t* bou
 
 void Checker::tick(double now, const uint8_t* atoms, const uint32_t* bound) {
   if (model_ != TimeModel::Dense || !(now >= clock_)) return;  // behind the clock (or NaN): nothing to do
+  if (explain_) explain::origin_ns = origin_ns_, explain::nanoseconds = nanoseconds_;
   if (now > clock_) step(clock_, now, atoms, bound);
   if (!delayed_.empty() && !finished_) last_atoms_.assign(atoms, atoms + atoms_.size());
   clock_ = now;

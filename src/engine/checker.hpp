@@ -37,6 +37,13 @@ struct Verdict {
   // docs/semantics.md, "Bounded future"). NaN for past-only properties,
   // whose verdicts are known at their own time.
   double known_at = std::numeric_limits<double>::quiet_NaN();
+  // Dense time (exact): `time` and `known_at` in integer nanoseconds, the
+  // origin added back (spec/exact_time.hpp) — what outputs print, exactly;
+  // `time`/`known_at` above are the same instants as double seconds, for
+  // consumers that only need a number (stores, the dashboard).
+  bool exact = false;
+  int64_t time_ns = 0;
+  int64_t known_ns = 0;
 };
 using VerdictCallback = std::function<void(const Verdict&)>;
 
@@ -106,6 +113,19 @@ class Checker {
   // The instant the monitors have reached: the end of the last step or tick
   // (0 before any).
   double clock() const { return clock_; }
+  // Dense time runs in nanoseconds from an origin (spec/exact_time.hpp):
+  // every time given to step/tick and returned by clock/next_deadline is
+  // (instant - origin) in ns, and verdicts carry the instant itself
+  // (Verdict::time_ns, and `time` in seconds). Set before the first step.
+  void set_origin(int64_t origin_ns) { origin_ns_ = origin_ns; }
+  // The monitors themselves are unit-agnostic (times and bounds in one unit,
+  // as Reelay's): by default the bounds as written and the times as given.
+  // count_nanoseconds() (before add_property; the runtime calls it for dense
+  // time) runs them on nanoseconds: bounds become the exact nanoseconds of
+  // their text, and verdicts carry exact instants (Verdict::exact).
+  void count_nanoseconds() { nanoseconds_ = model_ == TimeModel::Dense; }
+  bool nanoseconds() const { return nanoseconds_; }
+  int64_t origin() const { return origin_ns_; }
   // `atoms`/`bound`/`margins`: the values held since the last message (the
   // decoder's committed values, as the next step() will be given). A tick
   // before the clock does nothing; a tick at the clock only reports the
@@ -183,6 +203,9 @@ class Checker {
   int64_t now_robust_ = 0;
   int64_t now_discrete_ = 0;
   double clock_ = 0;  // dense time: where the last step or tick ended
+  int64_t origin_ns_ = 0;  // dense time: the instant engine time 0 stands for
+  bool nanoseconds_ = false;
+  Verdict verdict(size_t property, double time, bool value, double known) const;
   // Dense time: the instant a tick last reported the value at (NaN: none).
   // With emit_all, the step that starts there does not report it again.
   double told_at_ = std::numeric_limits<double>::quiet_NaN();

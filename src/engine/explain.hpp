@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "engine/program.hpp"
+#include "spec/exact_time.hpp"
 
 namespace rvc::engine::explain {
 
@@ -39,8 +40,17 @@ using ValueNames = std::function<std::string(uint32_t id)>;
 
 // A time in seconds with the fewest digits that give it back within a few
 // units in the last place: 3.3 - 1.5 is "1.8", not "1.7999999999999998".
+// Dense time: the instant engine time 0 stands for (engine::Checker sets it
+// while its monitors explain: their times are nanoseconds from the origin,
+// spec/exact_time.hpp).
+inline thread_local int64_t origin_ns = 0;
+inline thread_local bool nanoseconds = false;  // engine times are ns from origin_ns (else plain seconds)
+
+// A dense engine time as the instant's seconds: exactly, from nanoseconds;
+// else the shortest text that reads back close to it.
 inline std::string seconds(double v) {
   if (!std::isfinite(v)) return v > 0 ? "inf" : "-inf";
+  if (nanoseconds) return spec::seconds_text(origin_ns + static_cast<int64_t>(std::llround(v)));
   const double a = std::fabs(v);
   const double tolerance = std::max(1e-12, 8 * (std::nextafter(a, std::numeric_limits<double>::infinity()) - a));
   char buf[64];
@@ -107,7 +117,7 @@ class Walker {
       return from == to ? "at step " + std::to_string(from)
                         : "at steps " + std::to_string(from) + ".." + std::to_string(to);
     }
-    const double from = std::isinf(b.hi) ? 0 : std::max(0.0, now_ - b.hi);
+    const double from = std::isinf(b.hi) ? 0 : std::max(0.0, now_ - b.hi);  // ns from the origin
     const double to = now_ - b.lo;
     if (to < from) return "at no time yet";  // the window is still before time 0
     return from == to ? "at time " + seconds(from) : "in [" + seconds(from) + ", " + seconds(to) + "]";

@@ -1,5 +1,7 @@
 #include "io/cdr_decoder.hpp"
 
+#include "spec/exact_time.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -236,6 +238,7 @@ bool CdrDecoder::decode(std::string_view sample, std::string& error, std::vector
   error_ = &error;
   warnings_ = warnings;
   sec_ = nanosec_ = next_time_ = 0;
+  time_is_number_ = false;
   CdrError bad;
   CdrCursor in(bad);
   if (!in.open(sample) || !message(in, root_) || !in.finish()) {
@@ -243,9 +246,23 @@ bool CdrDecoder::decode(std::string_view sample, std::string& error, std::vector
     if (malformed_) error = "bad " + root_.type->full_name() + " sample: " + bad.to_string();
     return false;
   }
-  // (sec * 1e9 + nanosec) / 1e9: the correctly rounded time for stamps below
-  // 2^53 ns (104 days); epoch stamps round to about 0.2 us.
-  time_ = next_time_ + (sec_ * 1e9 + nanosec_) / 1e9;
+  // Exact nanoseconds: sec and nanosec are integers (int32/uint32 in a
+  // builtin_interfaces/Time), never summed as doubles of seconds.
+  int64_t ns = 0;
+  if (time_is_number_) {
+    const double t = spec::seconds_to_ns(next_time_);
+    if (!(std::fabs(t) < 9.2e18)) {
+      error = "time " + std::to_string(next_time_) + " is beyond the range of exact time (+-9223372036.854775807 s)";
+      return false;
+    }
+    ns = static_cast<int64_t>(t);
+  }
+  int64_t stamp = 0;
+  if (!spec::time_to_ns(static_cast<int64_t>(sec_), static_cast<int64_t>(nanosec_), stamp) ||
+      __builtin_add_overflow(ns, stamp, &time_ns_)) {
+    error = "time is beyond the range of exact time (+-9223372036.854775807 s)";
+    return false;
+  }
   return true;
 }
 
@@ -341,7 +358,7 @@ bool CdrDecoder::tested_field(CdrCursor& in, const FieldPlan& f) {
   if (!ok) return false;
   switch (f.time) {
     case TimeRole::None: break;
-    case TimeRole::Number: next_time_ = v.d; break;
+    case TimeRole::Number: next_time_ = v.d, time_is_number_ = true; break;
     case TimeRole::Sec: sec_ = v.d; break;
     case TimeRole::Nanosec: nanosec_ = v.d; break;
   }

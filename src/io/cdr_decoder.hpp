@@ -60,7 +60,11 @@ class CdrDecoder {
   const uint32_t* bound() const { return bound_.empty() ? nullptr : bound_.data(); }
   // The values data references bound so far (--explain names them).
   const BoundValues& bound_values() const { return bound_ids_; }
-  double time() const { return time_; }
+  // Dense time: the sample's time exactly, in nanoseconds (a Time's sec and
+  // nanosec are integers; a number field is seconds, read from its shortest
+  // text: spec/exact_time.hpp), and as double seconds.
+  int64_t time_ns() const { return time_ns_; }
+  double time() const { return static_cast<double>(time_ns_) / 1e9; }
 
   // "time" -> the field dense time reads in a message of this type when the
   // user kept the default: "time" if the type has it, else "header.stamp",
@@ -114,7 +118,9 @@ class CdrDecoder {
   std::vector<uint32_t> bound_, next_bound_;  // sized only when some test binds
   std::vector<double> margin_, next_margin_;  // sized only with DecoderOptions::robustness
   BoundValues bound_ids_;
-  double time_ = 0, next_time_ = 0;
+  int64_t time_ns_ = 0;
+  double next_time_ = 0;  // a number field's seconds
+  bool time_is_number_ = false;
   double sec_ = 0, nanosec_ = 0;
   bool malformed_ = false;
   bool refused_ = false;  // a strict-mode problem, not a bad sample

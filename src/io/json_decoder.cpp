@@ -1,5 +1,7 @@
 #include "io/json_decoder.hpp"
 
+#include "spec/exact_time.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -308,7 +310,34 @@ bool JsonDecoder::decode(simdjson::ondemand::object object, std::string& error, 
     return false;
   }
   if (options_.strict && !check_missing(root_, "", error)) return false;
-  time_ = next_time_;
+  time_ns_ = next_time_ns_;
+  return true;
+}
+
+bool JsonDecoder::read_time_text(std::string_view text, const std::string& name, int64_t& ns,
+                                 std::string& error) const {
+  switch (spec::parse_seconds(text, ns)) {
+    case spec::SecondsStatus::Ok: return true;
+    case spec::SecondsStatus::OutOfRange:
+      while (!text.empty() && (text.back() == ' ' || text.back() == '\t' || text.back() == '\r' || text.back() == '\n'))
+        text.remove_suffix(1);
+      error = "time field \"" + name + "\" is " + std::string(text.substr(0, 40)) +
+              " s: beyond the range of exact time (+-9223372036.854775807 s, int64 nanoseconds)";
+      return false;
+    case spec::SecondsStatus::Malformed: break;
+  }
+  error = "time field \"" + name + "\" is not a number of seconds";
+  return false;
+}
+
+// A Time {sec, nanosec}: sec exactly (as ns) plus nanosec, an integer count.
+bool JsonDecoder::combine_time(std::string& error) {
+  if (!(std::fabs(time_nsec_) < 9.2e18) ||
+      __builtin_add_overflow(time_sec_ns_, static_cast<int64_t>(std::llround(time_nsec_)), &next_time_ns_)) {
+    error = "time field \"" + options_.time_field + "\" is beyond the range of exact time (+-9223372036.854775807 s)";
+    return false;
+  }
+  saw_time_ = true;
   return true;
 }
 
@@ -395,14 +424,17 @@ bool JsonDecoder::decode_value(KeyNode& target, simdjson::ondemand::value value,
     double t;
     if (type == json_type::object) {  // a builtin_interfaces/Time: its parts come as its children
       saw_sec_ = false;
-      time_sec_ = time_nsec_ = 0;
-    } else if (type != json_type::number || value.get_double().get(t)) {
+      time_sec_ns_ = 0;
+      time_nsec_ = 0;
+    } else if (type != json_type::number) {
       error = "time field \"" + options_.time_field + "\" must be a number of seconds or a Time {sec, nanosec}, not " +
               type_name(type);
       return false;
     } else {
+      // Exactly from its text: a double would round epoch stamps to ~240 ns.
+      if (!read_time_text(value.raw_json_token(), options_.time_field, next_time_ns_, error)) return false;
       saw_time_ = true;
-      next_time_ = t;
+      (void)t;
     }
     // The time field may also be tested by atoms; re-reading a number is cheap.
   } else if (target.time_part >= 2) {
@@ -411,8 +443,12 @@ bool JsonDecoder::decode_value(KeyNode& target, simdjson::ondemand::value value,
       error = "time field \"" + options_.time_field + "." + target.name + "\" must be a number, not " + type_name(type);
       return false;
     }
-    if (target.time_part == 2) saw_sec_ = true, time_sec_ = part;
-    else time_nsec_ = part;
+    if (target.time_part == 2) {
+      if (!read_time_text(value.raw_json_token(), options_.time_field + ".sec", time_sec_ns_, error)) return false;
+      saw_sec_ = true;
+    } else {
+      time_nsec_ = part;
+    }
   }
   if (type == json_type::object && !target.children.empty()) {
     simdjson::ondemand::object inner;
@@ -430,8 +466,7 @@ bool JsonDecoder::decode_value(KeyNode& target, simdjson::ondemand::value value,
         error = "time field \"" + options_.time_field + "\" is an object without \"sec\" (a Time is {sec, nanosec})";
         return false;
       }
-      saw_time_ = true;
-      next_time_ = (time_sec_ * 1e9 + time_nsec_) / 1e9;  // as the typed path computes a Time (same double)
+      if (!combine_time(error)) return false;
     }
     return true;
   }

@@ -80,7 +80,11 @@ class JsonDecoder {
   const double* margins() const { return margin_.data(); }
   // The values data references bound so far (--explain names them).
   const BoundValues& bound_values() const { return bound_ids_; }
-  double time() const { return time_; }
+  // Dense time: the message's time, exactly, in nanoseconds (read from the
+  // number's decimal text, or a Time's sec and nanosec; spec/exact_time.hpp),
+  // and as double seconds.
+  int64_t time_ns() const { return time_ns_; }
+  double time() const { return static_cast<double>(time_ns_) / 1e9; }
 
  private:
   // Fast paths: most fields are tested only as Booleans or only as numbers;
@@ -176,9 +180,13 @@ class JsonDecoder {
   std::vector<double> margin_, next_margin_;
   std::vector<QuantFold> folds_;  // per atom, sized when some test is an array quantifier
   uint32_t element_index_ = 0;    // the element being decoded into a "[*]" node
-  double time_ = 0, next_time_ = 0;
+  int64_t time_ns_ = 0, next_time_ns_ = 0;
   bool saw_time_ = false;
-  double time_sec_ = 0, time_nsec_ = 0;  // parts of a Time object
+  int64_t time_sec_ns_ = 0;  // parts of a Time object: sec (as ns), nanosec
+  double time_nsec_ = 0;
+  // The time number's text as nanoseconds, or false with `error` set.
+  bool read_time_text(std::string_view text, const std::string& name, int64_t& ns, std::string& error) const;
+  bool combine_time(std::string& error);
   bool saw_sec_ = false;
   bool malformed_ = false;
   uint32_t generation_ = 0;

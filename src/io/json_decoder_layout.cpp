@@ -6,6 +6,7 @@
 #include <cstring>
 
 #include "io/json_decoder.hpp"
+#include "spec/exact_time.hpp"
 #include "io/raw_key.hpp"
 
 namespace rvc::io {
@@ -205,15 +206,16 @@ bool JsonDecoder::decode_matched(std::string& error, std::vector<std::string>* w
         else number_tests(target, v.d);
         continue;
       case SlotUse::Time:  // a number (match() made sure)
+        // Exactly from its text (the scanner keeps it in v.s).
+        if (!read_time_text(v.s, options_.time_field, next_time_ns_, error)) return false;
         saw_time_ = true;
-        next_time_ = v.d;
         if (target.tests.empty()) continue;
         break;
       case SlotUse::General: break;
     }
     if (!apply_value(target, v, error, warnings)) return false;
   }
-  time_ = next_time_;  // a layout of a dense stream always has its time slot
+  time_ns_ = next_time_ns_;  // a layout of a dense stream always has its time slot
   return true;
 }
 

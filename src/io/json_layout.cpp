@@ -143,7 +143,10 @@ inline const char* scan_scalar(const char* p, const char* end, bool convert, Fie
     default:
       v.kind = ValueKind::Number;
       v.exact.kind = spec::ExactInt::None;  // (its bits mean nothing then)
-      return scan_number(p, end, convert, v.d, v.exact);
+      const char* stop = scan_number(p, end, convert, v.d, v.exact);
+      // The number's text: dense time reads a time slot from it exactly.
+      if (stop) v.s = std::string_view(p, static_cast<size_t>(stop - p));
+      return stop;
   }
 }
 

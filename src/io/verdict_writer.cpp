@@ -6,16 +6,28 @@
 namespace rvc::io {
 
 void append_verdict(std::string& out, double time, bool /*discrete: times print alike*/, std::string_view property, bool value) {
+  std::string t;
+  append_number(t, time);
+  append_verdict_at(out, t, property, value);
+}
+
+void append_verdict_at(std::string& out, std::string_view time, std::string_view property, bool value) {
   out += "{\"time\":";
-  append_number(out, time);
+  out += time;
   out += ",\"property\":";
   append_json_string(out, property);
   out += value ? ",\"value\":true}\n" : ",\"value\":false}\n";
 }
 
 void append_robustness(std::string& out, double time, bool /*discrete*/, std::string_view property, double value) {
+  std::string t;
+  append_number(t, time);
+  append_robustness_at(out, t, property, value);
+}
+
+void append_robustness_at(std::string& out, std::string_view time, std::string_view property, double value) {
   out += "{\"time\":";
-  append_number(out, time);
+  out += time;
   out += ",\"property\":";
   append_json_string(out, property);
   out += ",\"value\":";

@@ -12,7 +12,11 @@
 
 namespace rvc::io {
 
-// Appends one verdict line (with '\n') to `out`.
+// Appends one verdict line (with '\n') to `out`. The *_at forms take the
+// time's JSON text: dense time prints exact decimal seconds (at most 9
+// decimals, never an exponent: spec::append_seconds).
+void append_verdict_at(std::string& out, std::string_view time, std::string_view property, bool value);
+void append_robustness_at(std::string& out, std::string_view time, std::string_view property, double value);
 void append_verdict(std::string& out, double time, bool discrete, std::string_view property, bool value);
 // The same with a robustness value: {"time":3,"property":"p1","value":-1.5}
 // (infinities as the strings "inf" and "-inf", as JSON has no number for them).
@@ -21,11 +25,16 @@ void append_robustness(std::string& out, double time, bool discrete, std::string
 // became known, to the verdict line just appended:
 // {"time":3,"property":"p1","value":false,"known_at":5}. Past-only
 // properties' lines have no such field (known at "time").
-inline void append_known_at(std::string& out, double known_at) {
+inline void append_known_at_text(std::string& out, std::string_view known_at) {
   out.resize(out.size() - 2);  // "}\n"
   out += ",\"known_at\":";
-  append_number(out, known_at);
+  out += known_at;
   out += "}\n";
+}
+inline void append_known_at(std::string& out, double known_at) {
+  std::string t;
+  append_number(t, known_at);
+  append_known_at_text(out, t);
 }
 
 // Appends one verdict as a CDR sample of rvc_msgs/msg/Verdict (src/msg/definitions;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <limits>
 #include <stdexcept>
@@ -9,6 +10,7 @@
 #include "io/cdr_codec.hpp"
 #include "io/verdict_writer.hpp"
 #include "runtime/typed_specs.hpp"
+#include "spec/exact_time.hpp"
 #include "spec/parser.hpp"
 #include "spec/spec_error.hpp"
 
@@ -43,6 +45,7 @@ void check_unnamed(const std::vector<engine::PropertySpec>& properties, const Pi
 engine::Checker build(const std::vector<engine::PropertySpec>& properties, const PipelineOptions& options,
                       engine::VerdictCallback on_verdict) {
   engine::Checker checker(options.model, options.emit_all, std::move(on_verdict));
+  checker.count_nanoseconds();  // dense time: exact nanoseconds (runtime/engine_time.hpp)
   checker.set_incremental(options.incremental);
   if (options.robustness) checker.enable_robustness();
   if (options.explain) checker.enable_explain();
@@ -104,6 +107,7 @@ Pipeline::Pipeline(const std::vector<engine::PropertySpec>& properties, const Pi
                                           options.strict, needs_margins(options, timed_.get()), options.layouts,
                                           options.incremental}),
       batch_reader_(*this, options.max_message_size) {
+  time_ = EngineTime(options.origin);
   make_typed_decoder();
   if (timed_) {
     timed_values_.assign(atoms_.size(), 0);
@@ -133,7 +137,9 @@ void Pipeline::send_explained(const engine::VerdictCallback& send, const engine:
           s.compare(s.size() - now.size(), now.size(), now) == 0)
         s += " (" + timed_->describe(static_cast<int>(id)) + ")";
   }
-  send(engine::Verdict{v.property, v.time, v.value, v.robust, v.robustness, &why});
+  engine::Verdict explained = v;
+  explained.explanation = &why;
+  send(explained);
 }
 
 void Pipeline::make_typed_decoder() {
@@ -151,6 +157,7 @@ Pipeline::Pipeline(const engine::AtomTable& atoms, const PipelineOptions& option
       decoder_(atoms_, io::DecoderOptions{options.model == engine::TimeModel::Dense, options.time_field,
                                           options.strict, options.robustness, options.layouts, options.incremental}),
       batch_reader_(*this, options.max_message_size) {
+  time_ = EngineTime(options.origin);
   make_typed_decoder();
 }
 
@@ -241,9 +248,9 @@ void Pipeline::commit() {
   if (hook_) {
     const bool timed = options_.model == engine::TimeModel::Dense;
     const double t = timed ? message_time() : std::numeric_limits<double>::quiet_NaN();
-    if (timed && !(t >= 0 && t < std::numeric_limits<double>::infinity())) {
+    if (timed && message_time_ns() < 0) {
       on_error(io::LineError{pending_where_->number(), 0,
-                             "time " + number(t) + " is not a time (negative, infinite or not a number)"});
+                             "time " + spec::seconds_text(message_time_ns()) + " is negative (not a time)"});
       return;
     }
     commit_values();
@@ -259,15 +266,29 @@ void Pipeline::commit() {
     arrive_timed(static_cast<double>(steps_++));
     step_checker(*pending_where_, [&] { checker_.step(held_values(), bound()); });
   } else {
-    // Dense: this message closes [previous time, its time) with the previous values.
-    double t = message_time();
-    double begin = has_time_ ? last_time_ : 0;
-    if (!(t >= 0) || (has_time_ && !(t > last_time_))) {
-      std::string why = t < 0 ? "time " + number(t) + " is negative (the timeline starts at 0)"
-                              : "time " + number(t) + " is not after the previous message's time " +
-                                    number(last_time_) + " (dense time needs strictly increasing times)";
+    // Dense: this message closes [previous time, its time) with the previous
+    // values. Times are exact nanoseconds (spec/exact_time.hpp); the engine
+    // counts them from the origin (the first message, or 0).
+    const int64_t ns = message_time_ns();
+    if (ns < 0 || (has_time_ && ns <= last_ns_)) {
+      std::string why = ns < 0 ? "time " + spec::seconds_text(ns) + " is negative (the timeline starts at 0)"
+                               : "time " + spec::seconds_text(ns) + " is not after the previous message's time " +
+                                     spec::seconds_text(last_ns_) + " (dense time needs strictly increasing times)";
       on_error(io::LineError{pending_where_->number(), 0, why});
       return;
+    }
+    if (!time_.started()) {
+      time_.start(ns);
+      checker_.set_origin(time_.origin_ns());
+    }
+    double t = time_.engine(ns);
+    double begin = has_time_ ? last_time_ : 0;
+    if (!warned_inexact_ && !EngineTime::exact(t)) {
+      warned_inexact_ = true;
+      report("warning: " + options_.position_name + " " + std::to_string(pending_where_->number()) + ": time " +
+             spec::seconds_text(ns) + " is more than 9007199.254740992 s (2^53 ns, about 104 days) after the " +
+             "timeline's start " + spec::seconds_text(time_.origin_ns()) +
+             ": from here on times are no longer exact to the nanosecond (warned once)");
     }
     if (t <= checker_.clock() && checker_.clock() > last_time_) note_late(t);
     // Timed atoms that change before t: the monitors step to each change
@@ -283,6 +304,7 @@ void Pipeline::commit() {
     arrive_timed(t);
     has_time_ = true;
     last_time_ = t;
+    last_ns_ = ns;
   }
   ++stats_.accepted;
   stats_.by_layout += pending_matched_;
@@ -298,7 +320,8 @@ void Pipeline::advance_timed(double t) {
 void Pipeline::arrive_timed(double t) {
   if (!timed_) return;
   timed_->advance(t);
-  const double latency = arrival_ - t;  // NaN without an arrival (a file's lines)
+  // NaN without an arrival (a file's lines); dense time: engine nanoseconds.
+  const double latency = checker_.model() == engine::TimeModel::Dense ? time_.from_seconds(arrival_) - t : arrival_ - t;
   timed_->arrive(0, latency, values(), margins());
 }
 
@@ -328,6 +351,11 @@ void Pipeline::feed_logged(uint32_t, std::string_view payload, uint64_t position
   feed(payload, position);
 }
 
+std::string Pipeline::instant_text(double engine) const {
+  if (!std::isfinite(engine)) return engine > 0 ? "inf" : "-inf";
+  return spec::seconds_text(time_.origin_ns() + std::llround(engine));
+}
+
 void Pipeline::note_late(double t) {
   ++stats_.late_to_clock;
   if (warned_late_) return;
@@ -336,18 +364,29 @@ void Pipeline::note_late(double t) {
                "rvc: warning: %s %llu: time %s is not after %s, where the clock's ticks had taken the monitors: checked "
                "as if at %s (counted as late_to_clock; warned once)\n",
                options_.position_name.c_str(), static_cast<unsigned long long>(pending_where_->number()),
-               number(t).c_str(), number(checker_.clock()).c_str(), number(checker_.clock()).c_str());
+               instant_text(t).c_str(), instant_text(checker_.clock()).c_str(), instant_text(checker_.clock()).c_str());
 }
 
 double Pipeline::next_deadline() {
   if (!ticking()) return std::numeric_limits<double>::infinity();
   const double d = checker_.robustness() ? checker_.next_deadline_robust(held_margins())
                                          : checker_.next_deadline(held_values(), bound());
-  return std::min(d, timed_next_change());
+  deadline_engine_ = std::min(d, timed_next_change());
+  deadline_seconds_ = time_.seconds(deadline_engine_);
+  return deadline_seconds_;
 }
 
-void Pipeline::tick(double stream_now) {
+// A Feed time (seconds) in engine time: the instants this pipeline handed
+// out (the last stamp, the last deadline) map back exactly.
+double Pipeline::engine_of(double stream_seconds) const {
+  if (stream_seconds == last_stamp()) return last_time_;
+  if (stream_seconds == deadline_seconds_) return deadline_engine_;
+  return time_.from_seconds(stream_seconds);
+}
+
+void Pipeline::tick(double stream_seconds) {
   if (!ticking()) return;
+  const double stream_now = engine_of(stream_seconds);
   // Timed atoms that change by `stream_now` ({@age <= 0.2} falling): the
   // monitors close [clock, c) with the values before the change, as a
   // message's step does, and go on from c with the changed ones.
@@ -357,7 +396,7 @@ void Pipeline::tick(double stream_now) {
         if (checker_.robustness()) checker_.step_robust(checker_.clock(), c, held_margins());
         else checker_.step(checker_.clock(), c, held_values(), bound());
       } catch (const engine::data::DataLimitError& e) {
-        throw engine::data::DataLimitError("tick at time " + number(c) + ": " + e.what());
+        throw engine::data::DataLimitError("tick at time " + instant_text(c) + ": " + e.what());
       }
     }
     advance_timed(c);
@@ -370,7 +409,7 @@ void Pipeline::step_to(double instant) {
     if (checker_.robustness()) checker_.tick_robust(instant, held_margins());
     else checker_.tick(instant, held_values(), bound());
   } catch (const engine::data::DataLimitError& e) {  // named as a step's error names its message
-    throw engine::data::DataLimitError("tick at time " + number(instant) + ": " + e.what());
+    throw engine::data::DataLimitError("tick at time " + instant_text(instant) + ": " + e.what());
   }
 }
 

@@ -21,6 +21,7 @@
 #include "io/json_decoder.hpp"
 #include "io/jsonl_reader.hpp"
 #include "msg/msg_types.hpp"
+#include "runtime/engine_time.hpp"
 #include "runtime/feed.hpp"
 
 namespace rvc::runtime {
@@ -55,6 +56,9 @@ struct PipelineOptions {
   // Where each error and warning line goes (without the "rvc: " prefix); empty: stderr, at most
   // max_reported of them. The Python package (python/) turns them into exceptions and warnings.
   std::function<void(const std::string& text)> on_report;
+  // Dense time: where the timeline starts (runtime/engine_time.hpp): the
+  // first message (default) or 0 (--origin zero, Reelay's rule).
+  Origin origin = Origin::First;
 };
 
 // Decode-only mode (a synchronized input, see SyncedPipeline): each accepted
@@ -129,8 +133,13 @@ class Pipeline final : public io::JsonlHandler, public Feed {
   void tick(double stream_now) override;
   void settle() override { checker_.finish(); }
   double last_stamp() const override {
-    return has_time_ ? last_time_ : std::numeric_limits<double>::quiet_NaN();
+    return has_time_ ? static_cast<double>(last_ns_) / 1e9 : std::numeric_limits<double>::quiet_NaN();
   }
+  // The last accepted message's exact time (dense), and the message being
+  // committed (decode-only pipelines: their hook's time, exactly).
+  int64_t last_stamp_ns() const { return last_ns_; }
+  int64_t message_time_ns() const { return typed_ ? typed_->time_ns() : decoder_.time_ns(); }
+  const EngineTime& engine_time() const { return time_; }
 
  private:
   // --explain (discrete): an expression atom's sentence about the current
@@ -181,7 +190,16 @@ class Pipeline final : public io::JsonlHandler, public Feed {
   // Where the pending message came from. A copy, not a pointer: the reader's
   // Position may be a temporary that is gone by commit().
   std::optional<io::Position> pending_where_;
-  double last_time_ = 0;
+  double last_time_ = 0;  // engine time of the last message (dense)
+  int64_t last_ns_ = 0;   // ... and its exact stamp
+  EngineTime time_;
+  // The last deadline handed out, in Feed seconds and engine time: a tick at
+  // exactly that double is at exactly that engine time (no rounding back).
+  double deadline_seconds_ = std::numeric_limits<double>::quiet_NaN();
+  double deadline_engine_ = 0;
+  bool warned_inexact_ = false;
+  double engine_of(double stream_seconds) const;
+  std::string instant_text(double engine) const;  // an engine time as the instant's exact seconds
   uint64_t reported_ = 0;
   bool warned_late_ = false;
   std::vector<std::string> warnings_;  // of the pending message, reported at commit()

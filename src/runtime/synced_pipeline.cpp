@@ -41,6 +41,7 @@ struct SyncedPipeline::Held {
   uint32_t input = 0;
   bool used = false;
   double stamp = 0;       // its own stamp (a late message checked with --late process goes out later)
+  int64_t stamp_ns = 0;   // ... exactly (dense time)
   uint64_t position = 0;  // its line or sequence number, for messages about it
   double arrival = 0;     // when rvc received it ({input.@latency})
   std::vector<uint8_t> values;  // in the input's atom order
@@ -142,6 +143,8 @@ SyncedPipeline::SyncedPipeline(const std::vector<engine::PropertySpec>& properti
       sync_(sync),
       on_set_(std::move(on_set)) {
   checker_.set_incremental(options.incremental);
+  checker_.count_nanoseconds();  // dense time: exact nanoseconds (runtime/engine_time.hpp)
+  time_ = EngineTime(options.origin);
   if (inputs.empty()) throw std::invalid_argument("no inputs to synchronize");
   if (options.robustness)
     throw std::invalid_argument("--robustness checks one input for now (not several synchronized ones)");
@@ -293,6 +296,7 @@ void SyncedPipeline::accept(uint32_t input, const uint8_t* values, double time, 
   h.input = input;
   h.used = false;
   h.stamp = stamp;
+  h.stamp_ns = in.arrival_stamp ? std::llround(stamp * 1e9) : in.pipeline->message_time_ns();
   h.position = position;
   h.arrival = arrival_;
   h.values.assign(values, values + in.atoms->size());
@@ -382,6 +386,16 @@ void SyncedPipeline::report_late(const sync::Member& message, double after, bool
 }
 
 void SyncedPipeline::on_set(const sync::Member* members, size_t count, double set_stamp) {
+  // The set's instant exactly: the stamp of the member it is (every policy
+  // stamps a set with one of its members' stamps).
+  int64_t set_ns = std::llround(set_stamp * 1e9);
+  for (size_t m = 0; m < count; ++m)
+    if (held_[members[m].token].stamp == set_stamp) set_ns = held_[members[m].token].stamp_ns;
+  if (options_.model == engine::TimeModel::Dense && !time_.started()) {
+    time_.start(set_ns);
+    checker_.set_origin(time_.origin_ns());
+  }
+  const double set_engine = time_.engine(set_ns);
   if (options_.model == engine::TimeModel::Dense) {
     // Dense time needs strictly increasing times; every policy but latest
     // guarantees it, latest follows its pivot input's own order.
@@ -391,24 +405,24 @@ void SyncedPipeline::on_set(const sync::Member* members, size_t count, double se
              std::to_string(last_time_) + " (dense time needs strictly increasing times; set skipped)");
       return;
     }
-    if (has_time_ && set_stamp <= checker_.clock() && checker_.clock() > last_time_ && late_to_clock_++ == 0)
+    if (has_time_ && set_engine <= checker_.clock() && checker_.clock() > last_engine_ && late_to_clock_++ == 0)
       std::fprintf(stderr,
                    "rvc: warning: set at time %s is not after %s, where the clock's ticks had taken the monitors: "
                    "checked as if at that instant (counted as late_to_clock; warned once)\n",
-                   stamp_text(set_stamp).c_str(), stamp_text(checker_.clock()).c_str());
+                   stamp_text(set_stamp).c_str(), stamp_text(time_.seconds(checker_.clock())).c_str());
     // The set closes [previous time, its time) with the previous values,
     // stepping first through the instants where timed atoms change (those
     // a tick has already passed were stepped through by it).
-    double begin = has_time_ ? last_time_ : 0;
+    double begin = has_time_ ? last_engine_ : 0;
     if (!options_.parse_only) {
-      for (double c; (c = timed_next_change()) < set_stamp; begin = c) {
+      for (double c; (c = timed_next_change()) < set_engine; begin = c) {
         checker_.step(begin, c, held_values());
         advance_timed(c);
       }
-      checker_.step(begin, set_stamp, held_values());
+      checker_.step(begin, set_engine, held_values());
     }
   }
-  if (timed_) timed_->advance(options_.model == engine::TimeModel::Dense ? set_stamp : static_cast<double>(sets_));
+  if (timed_) timed_->advance(options_.model == engine::TimeModel::Dense ? set_engine : static_cast<double>(sets_));
   for (size_t m = 0; m < count; ++m) {
     Held& h = held_[members[m].token];
     Input& in = inputs_[members[m].input];
@@ -425,7 +439,11 @@ void SyncedPipeline::on_set(const sync::Member* members, size_t count, double se
       ++in.counters.used;
       // Its first set: the input arrives ({in.@arrived}, its age restarts, a sample).
       if (timed_)
-        timed_->arrive(members[m].input, in.arrival_stamp ? 0 : h.arrival - h.stamp, combined_.data(),
+        timed_->arrive(members[m].input,
+                       in.arrival_stamp ? 0
+                       : options_.model == engine::TimeModel::Dense ? std::round((h.arrival - h.stamp) * 1e9)
+                                                                     : h.arrival - h.stamp,
+                       combined_.data(),
                        combined_margins_.empty() ? nullptr : combined_margins_.data());
     }
     if (on_set_) in.last_text = h.text;
@@ -433,10 +451,12 @@ void SyncedPipeline::on_set(const sync::Member* members, size_t count, double se
   if (options_.model == engine::TimeModel::Discrete && !options_.parse_only) checker_.step(held_values());
   has_time_ = true;
   last_time_ = set_stamp;
+  last_engine_ = set_engine;
   ++sets_;
   if (on_set_) {
     io::JsonObject set;
-    set.add("time", set_stamp);
+    if (options_.model == engine::TimeModel::Dense) set.add_raw("time", spec::seconds_text(set_ns));  // exactly
+    else set.add("time", set_stamp);
     for (const Input& in : inputs_)
       if (!in.last_text.empty()) set.add_raw(in.spec.name, in.last_text);
     json_ = set.str();
@@ -503,11 +523,21 @@ void SyncedPipeline::idle() {
 
 double SyncedPipeline::next_deadline() {
   if (!ticking()) return std::numeric_limits<double>::infinity();
-  return std::min(checker_.next_deadline(held_values()), timed_next_change());
+  deadline_engine_ = std::min(checker_.next_deadline(held_values()), timed_next_change());
+  deadline_seconds_ = time_.seconds(deadline_engine_);
+  return deadline_seconds_;
 }
 
-void SyncedPipeline::tick(double stream_now) {
+// As Pipeline::engine_of: the instants handed out map back exactly.
+double SyncedPipeline::engine_of(double stream_seconds) const {
+  if (stream_seconds == last_time_) return last_engine_;
+  if (stream_seconds == deadline_seconds_) return deadline_engine_;
+  return time_.from_seconds(stream_seconds);
+}
+
+void SyncedPipeline::tick(double stream_seconds) {
   if (!ticking()) return;
+  const double stream_now = engine_of(stream_seconds);
   // Timed atoms that change by `stream_now` ({imu.@age <= 0.1} falling):
   // the monitors close [clock, c) with the values before the change, as a
   // set's step does, and go on from c with the changed ones.

@@ -154,7 +154,11 @@ class SyncedPipeline final : public Feed, private sync::Handler {
   uint64_t late_checked_ = 0, late_reported_ = 0;
   uint64_t late_to_clock_ = 0;  // sets stamped at or before the instant ticks had reached
   bool has_time_ = false, ended_ = false;
-  double last_time_ = 0;
+  double last_time_ = 0;     // the last set's stamp, seconds (the policies' unit)
+  double last_engine_ = 0;   // ... in engine time (runtime/engine_time.hpp), exact
+  EngineTime time_;
+  double deadline_seconds_ = std::numeric_limits<double>::quiet_NaN(), deadline_engine_ = 0;
+  double engine_of(double stream_seconds) const;
   uint32_t feeding_ = 0;           // the input whose payload is being decoded
   double arrival_ = 0;             // of that payload
   std::string_view message_;       // that payload (for on_set's JSON)

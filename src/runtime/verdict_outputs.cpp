@@ -8,6 +8,7 @@
 #include "io/cdr_codec.hpp"
 #include "io/json_writer.hpp"
 #include "io/verdict_writer.hpp"
+#include "spec/exact_time.hpp"
 
 namespace rvc::runtime {
 
@@ -26,6 +27,7 @@ uint64_t VerdictOutputs::log_time_of(const engine::Verdict& v) const {
     return static_cast<uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
                                      std::chrono::system_clock::now().time_since_epoch())
                                      .count());
+  if (v.exact) return v.time_ns > 0 ? static_cast<uint64_t>(v.time_ns) : 0;  // dense: the instant, exactly
   if (!(v.time > 0)) return 0;
   if (discrete_) return static_cast<uint64_t>(v.time);
   const double ns = std::round(v.time * 1e9);
@@ -44,8 +46,11 @@ void VerdictOutputs::put(const engine::Verdict& v) {
     for (auto* t : timeline_) t->put_verdict(cdr_, at);
   }
   line_.clear();
-  if (v.robust) io::append_robustness(line_, v.time, discrete_, v.property, v.robustness);
-  else io::append_verdict(line_, v.time, discrete_, v.property, v.value);
+  time_text_.clear();
+  if (v.exact) spec::append_seconds(time_text_, v.time_ns);  // exact decimal seconds (dense)
+  else io::append_number(time_text_, v.time);
+  if (v.robust) io::append_robustness_at(line_, time_text_, v.property, v.robustness);
+  else io::append_verdict_at(line_, time_text_, v.property, v.value);
   if (v.explanation && (!type_ || verdict_type)) {  // {"time":..,"value":false,"explain":["...", ...]} (other typed verdicts have no field for it)
     line_.resize(line_.size() - 2);  // "}\n"
     line_ += ",\"explain\":[";
@@ -55,7 +60,10 @@ void VerdictOutputs::put(const engine::Verdict& v) {
     }
     line_ += "]}\n";
   }
-  if (v.known_at == v.known_at && !type_) io::append_known_at(line_, v.known_at);  // bounded future: not NaN
+  if (v.known_at == v.known_at && !type_) {  // bounded future: not NaN
+    if (v.exact) io::append_known_at_text(line_, spec::seconds_text(v.known_ns));
+    else io::append_known_at(line_, v.known_at);
+  }
   if (!mark_.empty() && !type_) line_.insert(line_.size() - 2, mark_);  // before "}\n"
   line_.pop_back();  // one message per verdict: no newline (file sinks add their own)
   if (verdict_type) sample_ = cdr_;

@@ -84,6 +84,7 @@ class VerdictOutputs {
   bool discrete_;
   uint64_t count_ = 0;
   std::string line_, sample_;
+  std::string time_text_;  // the verdict's time as JSON text
   std::string_view mark_;
   const msg::MessageType* type_ = nullptr;
   std::vector<bool> typed_;

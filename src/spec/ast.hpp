@@ -20,6 +20,12 @@ struct Bounds {
   double lo = 0;
   double hi = kInfinity;
   bool explicit_bounds = false;  // written as [..] in the spec
+  // Dense time: the bounds in integer nanoseconds, read exactly from their
+  // text (spec/exact_time.hpp; at most kExactSpanNs, so a double holds them
+  // exactly). The engine's dense monitors run on these (engine::Checker
+  // rescales its copy of the formula); lo/hi stay the written seconds.
+  double lo_ns = 0;
+  double hi_ns = kInfinity;
   bool unbounded() const { return lo == 0 && hi == kInfinity; }
 };
 

@@ -1,6 +1,7 @@
 // Recursive-descent parser for Rye. Works directly on characters: the grammar
 // is small, and a hand-written scanner gives exact columns for every error.
 #include "spec/parser.hpp"
+#include "spec/exact_time.hpp"
 
 #include <pthread.h>
 
@@ -391,10 +392,10 @@ class Parser {
     b.explicit_bounds = true;
     skip_ws();
     bool has_lo = peek() != ':';
-    if (has_lo) b.lo = parse_bound_number();
+    if (has_lo) b.lo = parse_bound_number(b.lo_ns);
     expect(":", "between the lower and upper time bound, e.g. [3:10]");
     skip_ws();
-    if (peek() != ']') b.hi = parse_bound_number();
+    if (peek() != ']') b.hi = parse_bound_number(b.hi_ns);
     skip_ws();
     if (peek() != ']') fail("expected ']' to close the time bounds opened at column " + column_text(open), pos_);
     ++pos_;
@@ -402,7 +403,7 @@ class Parser {
     return b;
   }
 
-  double parse_bound_number() {
+  double parse_bound_number(double& ns) {
     skip_ws();
     size_t at = pos_;
     if (peek() == '-') fail("time bounds must not be negative", at);
@@ -423,7 +424,20 @@ class Parser {
         return static_cast<double>(v);
       }
     }
+    const size_t token_at = pos_;
     double v = parse_number_token("a time bound");
+    if (opt_.dense) {
+      // Exact nanoseconds from the text (0.025 is 25000000 ns, not the
+      // double nearest to 0.025 s), within the span dense time holds exactly.
+      int64_t exact = 0;
+      const SecondsStatus st = parse_seconds(std::string_view(s_).substr(token_at, pos_ - token_at), exact);
+      if (st != SecondsStatus::Ok || exact > kExactSpanNs)
+        fail("time bound " + s_.substr(token_at, pos_ - token_at) +
+                 " is too large: dense time is exact to the nanosecond up to 9007199.254740992 s (2^53 ns, "
+                 "about 104 days), and bounds must lie within it",
+             at);
+      ns = static_cast<double>(exact);
+    }
     if (!opt_.dense && v != std::floor(v))
       fail("discrete time needs integer bounds (use --dense for real-valued bounds)", at);
     if (!opt_.dense && v > static_cast<double>(kMaxDiscreteBound))

@@ -232,7 +232,7 @@ TEST(CdrDecoder, DenseTimeIsTheStampByDefault) {
   p.feed(encode(steer, R"({"stamp":{"sec":12,"nanosec":0},"steering_tire_angle":0.2})"), 3);
   EXPECT_EQ(p.stats().accepted, 3u);
   ASSERT_GE(out.size(), 2u);
-  EXPECT_DOUBLE_EQ(out.front().first, 0.0);  // [0, 10.25): before the first message
+  EXPECT_DOUBLE_EQ(out.front().first, 10.25);  // the timeline starts at the first stamp (issue 36)
   bool saw_violation_at_11_5 = false;
   for (auto [t, v] : out) saw_violation_at_11_5 = saw_violation_at_11_5 || (t == 11.5 && !v);
   EXPECT_TRUE(saw_violation_at_11_5);

@@ -169,6 +169,7 @@ TEST(FeedTicks, PipelineTicksAtItsDeadlines) {
   Verdicts out;
   PipelineOptions po;
   po.model = engine::TimeModel::Dense;
+  po.origin = runtime::Origin::Zero;  // the timeline from 0, as these expectations count it
   Pipeline p({{"p", "once[0:0.125]{alive}"}}, po, [&](const engine::Verdict& v) { out.emplace_back(v.time, v.value); });
   EXPECT_EQ(p.next_deadline(), INFINITY);  // nothing taken yet: no clock
   EXPECT_TRUE(std::isnan(p.last_stamp()));
@@ -221,6 +222,7 @@ TEST(FeedTicks, TimingAtomsFallByATickDuringSilence) {
   Verdicts out;
   PipelineOptions po;
   po.model = engine::TimeModel::Dense;
+  po.origin = runtime::Origin::Zero;  // the timeline from 0, as these expectations count it
   Pipeline p({{"p", "{@age <= 0.25} and {alive}"}}, po,
              [&](const engine::Verdict& v) { out.emplace_back(v.time, v.value); });
   p.feed(R"({"time":0.25,"alive":true})", 1);
@@ -242,6 +244,7 @@ TEST(FeedTicks, WindowCountDropsByATickDuringSilence) {
   Verdicts out;
   PipelineOptions po;
   po.model = engine::TimeModel::Dense;
+  po.origin = runtime::Origin::Zero;  // the timeline from 0, as these expectations count it
   Pipeline p({{"p", "{count[0:1](@arrived) >= 3}"}}, po,
              [&](const engine::Verdict& v) { out.emplace_back(v.time, v.value); });
   p.feed(R"({"time":0.25})", 1);

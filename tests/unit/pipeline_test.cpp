@@ -254,11 +254,16 @@ TEST(Pipeline, DenseNonIncreasingTimeRejectedAndLaterLinesProcessed) {
 TEST(Pipeline, DenseNegativeTimeAndLateStart) {
   PipelineOptions o;
   o.model = engine::TimeModel::Dense;
-  // The first valid message at 2 closes [0,2) with the initial (false) values.
-  Result r = run({{"p1", "{p}"}}, o, "{\"time\":-1,\"p\":true}\n{\"time\":2,\"p\":true}\n{\"time\":3}\n");
-  EXPECT_EQ(r.verdicts, (TVs{{0, false}, {2, true}}));
+  const std::string trace = "{\"time\":-1,\"p\":true}\n{\"time\":2,\"p\":true}\n{\"time\":3}\n";
+  // The timeline starts at the first valid message (issue 36): nothing is said before 2.
+  Result r = run({{"p1", "{p}"}}, o, trace);
+  EXPECT_EQ(r.verdicts, (TVs{{2, true}}));
   EXPECT_EQ(r.stats.rejected, 1u);
   EXPECT_NE(r.stderr_text.find("rvc: line 1: time -1 is negative"), std::string::npos) << r.stderr_text;
+  // --origin zero (Reelay's rule): the first message at 2 closes [0,2) with the initial (false) values.
+  o.origin = runtime::Origin::Zero;
+  Result z = run({{"p1", "{p}"}}, o, trace);
+  EXPECT_EQ(z.verdicts, (TVs{{0, false}, {2, true}}));
 }
 
 TEST(Pipeline, DenseBoundedOperatorOverAFile) {

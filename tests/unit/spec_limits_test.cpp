@@ -92,7 +92,11 @@ TEST(SpecBounds, DiscreteBoundsAreIntegersThatFit) {
   EXPECT_NE(error_of("once[-1:3]{p}").find("must not be negative"), std::string::npos);
   EXPECT_NE(error_of("once[5:2]{p}").find("empty time interval"), std::string::npos);
   EXPECT_NE(error_of("once[0:1e999]{p}", true).find("not a finite number"), std::string::npos);
-  EXPECT_EQ(error_of("once[0:1e30]{p}", true), "");  // dense bounds are real numbers
+  // Dense bounds are read to exact nanoseconds, up to 2^53 ns (spec/exact_time.hpp).
+  EXPECT_NE(error_of("once[0:1e30]{p}", true).find("too large"), std::string::npos);
+  EXPECT_NE(error_of("once[0:9007199.254740993]{p}", true).find("too large"), std::string::npos);
+  EXPECT_EQ(error_of("once[0:9007199.254740992]{p}", true), "");
+  EXPECT_EQ(error_of("once[0.000000001:0.025]{p}", true), "");
 }
 
 TEST(SpecColumns, CountCharactersNotBytes) {

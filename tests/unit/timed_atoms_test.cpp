@@ -180,6 +180,7 @@ Verdicts run(const std::string& spec, const std::vector<std::string>& lines, boo
   Verdicts out;
   runtime::PipelineOptions po;
   po.model = dense ? engine::TimeModel::Dense : engine::TimeModel::Discrete;
+  po.origin = runtime::Origin::Zero;  // the timeline from 0, as these expectations count it
   po.emit_all = !dense;
   testing::internal::CaptureStderr();
   {
@@ -255,6 +256,7 @@ TEST(TimedPipeline, LatencyIsArrivalMinusStamp) {
   Verdicts out;
   runtime::PipelineOptions po;
   po.model = engine::TimeModel::Dense;
+  po.origin = runtime::Origin::Zero;  // the timeline from 0, as these expectations count it
   runtime::Pipeline p({{"p", "{@latency < 0.1}"}}, po, [&](const engine::Verdict& v) { out.emplace_back(v.time, v.value); });
   p.feed_logged(0, R"({"time": 1})", 1, 1.05);
   p.feed_logged(0, R"({"time": 2})", 2, 2.25);  // 0.25 late
@@ -281,6 +283,7 @@ Verdicts run_synced(const std::string& spec, bool dense,
   Verdicts out;
   runtime::PipelineOptions po;
   po.model = dense ? engine::TimeModel::Dense : engine::TimeModel::Discrete;
+  po.origin = runtime::Origin::Zero;  // the timeline from 0, as these expectations count it
   po.emit_all = !dense;
   runtime::SyncOptions so;
   so.ordered = false;

@@ -5,6 +5,8 @@
 #include <limits>
 #include <stdexcept>
 
+#include "spec/exact_time.hpp"
+
 namespace rvc::engine::timed {
 namespace {
 
@@ -79,6 +81,10 @@ TimedAtoms::TimedAtoms(AtomTable& atoms, const std::vector<std::string>& inputs,
       if (inputs[i] == input) k = i, found = true;
     if (!found) throw std::invalid_argument("'" + test.to_string() + "' names no input");
     Atom a{static_cast<int>(id), k, test.timed.kind, test.op, test.value.number};
+    // Dense time runs in nanoseconds (spec/exact_time.hpp): an age or latency
+    // bound of 0.025 s is 25000000 ns exactly, read from the literal's
+    // shortest text, so a gap of exactly the bound is never a violation.
+    if (dense_ && (a.kind == Kind::Age || a.kind == Kind::Latency)) a.bound = spec::seconds_to_ns(a.bound);
     if (test.timed.kind == Kind::Latency) latency_ = true;
     if (test.timed.kind == Kind::Aggregate) {
       Source src{k, test.timed.of_arrivals};
@@ -92,7 +98,9 @@ TimedAtoms::TimedAtoms(AtomTable& atoms, const std::vector<std::string>& inputs,
         field_values_ = true;
       }
       a.window = static_cast<int>(windows_.size());
-      windows_.emplace_back(test.timed.func, test.timed.window, dense_);
+      spec::Bounds window = test.timed.window;
+      if (dense_) window.lo = window.lo_ns, window.hi = window.hi_ns;  // the exact nanoseconds of its text
+      windows_.emplace_back(test.timed.func, window, dense_);
       sources_.push_back(src);
     }
     atoms_.push_back(a);
@@ -240,6 +248,8 @@ void TimedAtoms::write(uint8_t* values) const {
 void TimedAtoms::write_margins(double* margins) const {
   for (const Atom& a : atoms_) {
     if (a.kind == Kind::Arrived) margins[a.id] = holds(a) ? 1 : 0;  // a Boolean field's margin
+    else if (dense_ && (a.kind == Kind::Age || a.kind == Kind::Latency))
+      margins[a.id] = margin(a.op, measure(a), a.bound) / 1e9;  // margins in seconds, as the spec wrote them
     else margins[a.id] = margin(a.op, measure(a), a.bound);
   }
   for (const ExprAtom& e : exprs_) margins[e.id] = e.margin;

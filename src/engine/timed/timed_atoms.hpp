@@ -31,6 +31,8 @@ class TimedAtoms {
   // {field: *} and {field}, are interned into `atoms` for it, and their
   // committed value and margin (the decoder's, DecoderOptions::robustness)
   // give the sample. Throws std::invalid_argument for an atom on no input.
+  // Dense time runs in engine nanoseconds (runtime/engine_time.hpp): every
+  // time given and returned, and the bounds, which it reads exactly.
   TimedAtoms(AtomTable& atoms, const std::vector<std::string>& inputs, TimeModel model);
 
   bool empty() const { return atoms_.empty() && exprs_.empty(); }
