@@ -16,6 +16,29 @@ InstancesFeed::InstancesFeed(const std::vector<engine::PropertySpec>& properties
 
 InstancesFeed::~InstancesFeed() = default;
 
+// The key string without writing it into the document's string buffer: that
+// buffer holds one unescaped copy of each string of the document (simdjson
+// sizes it so), and the instance's Pipeline unescapes every string again after
+// the object is reset; a key read there too overflowed it once the key was
+// about a third of the buffer (a 54,700-character key: heap corruption).
+// A key without escapes is its raw text; one with escapes is unescaped by a
+// parser of its own, in a buffer of its own.
+bool InstancesFeed::unescape_key(std::string_view raw, std::string_view& out) {
+  while (!raw.empty() && (raw.back() == ' ' || raw.back() == '\t' || raw.back() == '\r' || raw.back() == '\n'))
+    raw.remove_suffix(1);
+  if (raw.size() < 2 || raw.front() != '"' || raw.back() != '"') return false;
+  const std::string_view inner = raw.substr(1, raw.size() - 2);
+  if (inner.find('\\') == std::string_view::npos) {  // (UTF-8 was validated with the whole document)
+    out = inner;
+    return true;
+  }
+  key_scratch_.assign(raw.data(), raw.size());
+  key_scratch_.append(simdjson::SIMDJSON_PADDING, ' ');
+  simdjson::ondemand::document doc;
+  if (key_parser_.iterate(key_scratch_.data(), raw.size(), key_scratch_.size()).get(doc)) return false;
+  return !doc.get_string().get(out);
+}
+
 void InstancesFeed::report(const std::string& text) {
   if (reported_++ < options_.max_reported) std::fprintf(stderr, "rvc: %s\n", text.c_str());
 }
@@ -62,7 +85,7 @@ io::ReadResult InstancesFeed::on_object(const io::Position& where, simdjson::ond
       }
       if (type.value_unsafe() == simdjson::ondemand::json_type::string) {
         std::string_view s;
-        if (value.get_string().get(s)) {
+        if (!unescape_key(value.raw_json_token(), s)) {
           json_error_ = "invalid string";
           return io::ReadResult::Malformed;
         }

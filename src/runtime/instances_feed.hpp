@@ -83,6 +83,7 @@ class InstancesFeed final : public io::JsonlHandler, public Feed {
   void retire(Instance& instance);
   void drop_fresh();
   void report(const std::string& text);
+  bool unescape_key(std::string_view raw, std::string_view& out);
 
   std::vector<engine::PropertySpec> properties_;
   PipelineOptions options_;
@@ -103,6 +104,8 @@ class InstancesFeed final : public io::JsonlHandler, public Feed {
   uint64_t reported_ = 0;
   double last_stamp_ = std::numeric_limits<double>::quiet_NaN();
   std::string json_error_;
+  simdjson::ondemand::parser key_parser_;  // unescapes keys with escapes (unescape_key)
+  std::string key_scratch_;
   std::unordered_map<std::string, bool> refused_;  // keys refused by the limit (counted once each)
   mutable PipelineStats stats_;
 };
