@@ -154,6 +154,7 @@ struct CheckCommand {
   // --instances-by: one Pipeline per key value behind one reader (runtime/instances_feed.hpp).
   int run_instances(const std::vector<engine::PropertySpec>& properties, const runtime::PipelineOptions& popts,
                     runtime::VerdictOutputs& outputs, runtime::ResultsOutput* results, int fd, const std::string& path) {
+    iopts.tick_at_end = clock.ticks_at_end(check.dense);  // an expiring instance ends as its sub-trace would
     runtime::InstancesFeed feed(properties, popts, outputs, iopts);
     if (results) results->start(runtime::run_info(command_line(), {input}, properties, check.dense));
     io::ReaderOptions ropts;

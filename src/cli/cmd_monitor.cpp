@@ -625,6 +625,7 @@ struct MonitorCommand {
     attach_results(input, popts, verdicts);
     runtime::Pipeline pipeline(properties, popts, [&](const engine::Verdict& v) { verdicts.put(v); });
     std::unique_ptr<runtime::InstancesFeed> instance_feed;
+    iopts.tick_at_end = clock.ticks_at_end(check.dense);  // an expiring instance ends as its sub-trace would
     if (instances.given()) instance_feed = std::make_unique<runtime::InstancesFeed>(properties, popts, verdicts, iopts);
     std::unique_ptr<runtime::ServiceCallFeed> call_feed;
     if (check.calls)
