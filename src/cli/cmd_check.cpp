@@ -64,6 +64,12 @@ struct CheckCommand {
       return kUsage;
     }
     if (!outputs.empty()) output = outputs[0];
+    {
+      std::vector<std::pair<std::string, std::string>> written{{"--output", output}};
+      if (!store.database.empty()) written.emplace_back("the results database", store.database);
+      if (!store.options.spool.empty()) written.emplace_back("--spool", store.options.spool);
+      if (int status = refuse_shared_files(written)) return status;
+    }
     auto properties = check.properties();
     const std::string path = strip_file_scheme(input), opath = strip_file_scheme(output);
     if (opath != "-" && runtime::same_regular_file(path, opath)) {
