@@ -1,6 +1,7 @@
 #include "cli/check_options.hpp"
 
 #include "cli/option_ranges.hpp"
+#include "cli/option_rules.hpp"
 #include "io/properties_file.hpp"
 
 namespace rvc::cli {
@@ -32,11 +33,13 @@ void CheckOptions::add_to(CLI::App& app) {
   app.add_option("--time-field", time_field,
                  "Field holding the time in dense time: a path (header.stamp) to seconds or a Time {sec, nanosec} "
                  "(typed input without it: the message's header.stamp or stamp)")
+      ->check(field_name())
       ->capture_default_str();
   app.add_option("--max-message-size", max_message_size, "Longest accepted message in bytes")
       ->check(in_range(1, kMaxMessageSize, "bytes"))
       ->capture_default_str();
   app.add_option("--max-errors", max_reported, "Errors and warnings printed before going quiet (all are counted)")
+      ->check(in_range(0, 1e9))
       ->capture_default_str();
   app.add_flag("--calls", calls,
                "The input is a ROS 2 service's events (<service>/_service_event, pkg/srv/Name_Event): pair request "
@@ -46,7 +49,7 @@ void CheckOptions::add_to(CLI::App& app) {
   app.add_option("--service-timeout", service_timeout,
                                  "With --calls: seconds after its request a call with no response is made "
                                  "answered:false (by the events' stamps, or the monitor's clock)")
-                      ->check(CLI::PositiveNumber)
+                      ->check(above_up_to(0, kMaxSeconds, "seconds"))
                       ->capture_default_str();
   app.add_flag("--parse-only", parse_only, "Decode messages but run no monitor (the benchmark's floor)")
       ->group("");  // hidden: for bench/, not for users

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "cli/commands.hpp"
+#include "cli/option_ranges.hpp"
 #include "cli/type_options.hpp"
 #include "msg/type_registry.hpp"
 #include "cli/transport_flags.hpp"
@@ -157,10 +158,14 @@ Runner register_bridge(CLI::App& app) {
   sub->add_option("routes", cmd->uris, "FROM TO pairs: dds:TOPIC, zenoh:KEYEXPR, file:PATH")->required();
   sub->add_option("--wait-subscribers", cmd->wait_subscribers,
                   "Before forwarding, wait for this many subscribers on every TO (0 = do not wait)")
+      ->check(in_range(0, 100000))
       ->capture_default_str();
-  sub->add_option("--wait-timeout", cmd->wait_timeout, "Seconds to wait for them")->capture_default_str();
+  sub->add_option("--wait-timeout", cmd->wait_timeout, "Seconds to wait for them")
+      ->check(in_range(0, kMaxSeconds, "seconds"))
+      ->capture_default_str();
   sub->add_flag("--exit-on-eos", cmd->exit_on_eos, "Exit once every route forwarded an end-of-stream marker");
-  sub->add_option("--stats-interval", cmd->stats_interval, "Print forwarded counts every S seconds (stderr)");
+  sub->add_option("--stats-interval", cmd->stats_interval, "Print forwarded counts every S seconds (stderr)")
+      ->check(in_range(0, kMaxSeconds, "seconds"));
   cmd->typed.add_to(*sub,
                   "ROS 2 message type of the samples, pkg/msg/Name: dds: endpoints are topics of this type (as ROS 2 "
                   "nodes publish them), zenoh: endpoints carry their CDR (as zenoh-bridge-ros2dds does); "

@@ -23,6 +23,7 @@
 #include <string>
 
 #include "cli/commands.hpp"
+#include "cli/option_ranges.hpp"
 #include "io/service_calls.hpp"
 
 namespace rvc::cli {
@@ -118,7 +119,7 @@ Runner register_calls(CLI::App& app) {
   sub->add_option("input", cmd->input, "Input file of JSON lines (default: stdin)");
   sub->add_option("--service-timeout", cmd->timeout,
                   "Seconds after its request a call with no response is made as answered:false (default 1)")
-      ->check(CLI::PositiveNumber);
+      ->check(above_up_to(0, kMaxSeconds, "seconds"));
   sub->add_flag("--wall", cmd->wall,
                 "Live input: the system clock also moves time (the events' stamps are wall-clock ROS time), so an "
                 "unanswered request is reported at its deadline without waiting for the next event");

@@ -64,6 +64,12 @@ struct CheckCommand {
       return kUsage;
     }
     if (!outputs.empty()) output = outputs[0];
+    {
+      std::vector<std::pair<std::string, std::string>> written{{"--output", output}};
+      if (!store.database.empty()) written.emplace_back("the results database", store.database);
+      if (!store.options.spool.empty()) written.emplace_back("--spool", store.options.spool);
+      if (int status = refuse_shared_files(written)) return status;
+    }
     auto properties = check.properties();
     const std::string path = strip_file_scheme(input), opath = strip_file_scheme(output);
     if (opath != "-" && runtime::same_regular_file(path, opath)) {
@@ -154,6 +160,7 @@ struct CheckCommand {
   // --instances-by: one Pipeline per key value behind one reader (runtime/instances_feed.hpp).
   int run_instances(const std::vector<engine::PropertySpec>& properties, const runtime::PipelineOptions& popts,
                     runtime::VerdictOutputs& outputs, runtime::ResultsOutput* results, int fd, const std::string& path) {
+    iopts.tick_at_end = clock.ticks_at_end(check.dense);  // an expiring instance ends as its sub-trace would
     runtime::InstancesFeed feed(properties, popts, outputs, iopts);
     if (results) results->start(runtime::run_info(command_line(), {input}, properties, check.dense));
     io::ReaderOptions ropts;

@@ -81,7 +81,7 @@ Runner register_dashboard(CLI::App& app) {
       ->capture_default_str();
   sub->add_option("--poll", cmd->poll, "Seconds between looks for new rows (live updates)")
       ->capture_default_str()
-      ->check(CLI::Range(0.05, 10.0));
+      ->check(in_range(0.05, 10, "seconds"));
   sub->add_option("--silent-after", cmd->silent_after,
                   "A run with no end recorded and no counters recorded for S seconds is shown as silent (its "
                   "monitor died or hangs; a live one records them every second)")

@@ -13,6 +13,8 @@
 #include <vector>
 
 #include "cli/commands.hpp"
+#include "cli/option_ranges.hpp"
+#include "cli/option_rules.hpp"
 #include "cli/signals.hpp"
 #include "cli/transport_flags.hpp"
 #include "io/cdr_codec.hpp"
@@ -246,11 +248,13 @@ Runner register_echo(CLI::App& app) {
   cmd->typed.add_to(*sub, "Message type of the samples: ROS 2 pkg/msg/Name (`rvc msg list`) or a DDS IDL name from --msg-path");
   sub->add_option("--field", cmd->fields,
                   "Print only this field of each typed sample, e.g. status.twist (repeatable; the rest is still "
-                  "checked)");
+                  "checked)")
+      ->check(field_name());
   sub->add_option("--topic", cmd->topic, "The topic of a bag to print (needed when the bag holds several)");
-  sub->add_option("--count,-n", cmd->count, "Stop after this many messages (default: no limit)");
+  sub->add_option("--count,-n", cmd->count, "Stop after this many messages (default: no limit)")
+      ->check(in_range(0, kMaxCount, "messages (0: no limit)"));
   sub->add_option("--idle-timeout", cmd->idle_timeout, "Stop after this many seconds without a message")
-      ->check(CLI::NonNegativeNumber);
+      ->check(in_range(0, kMaxSeconds, "seconds"));
   sub->footer("Exit status: 0 messages printed, 3 samples could not be decoded (or records of a bag were damaged), 5 stdout could not be written, "
               "6 nothing arrived.");
   add_transport_options(*sub, cmd->transports);

@@ -34,6 +34,7 @@
 #include "cli/hz_config.hpp"
 #include "cli/hz_report.hpp"
 #include "cli/option_ranges.hpp"
+#include "cli/option_rules.hpp"
 #include "cli/signals.hpp"
 #include "cli/transport_flags.hpp"
 #include "cli/type_options.hpp"
@@ -474,18 +475,21 @@ Runner register_hz(CLI::App& app) {
       ->check(in_range(2, kMaxWindow, "arrivals"));
   sub->add_option("--stamp-field", cmd->stamp_field,
                   "Latency = arrival - this field (a number of seconds or a Time); none: no latency (default: "
-                  "header.stamp or stamp of a typed message, \"time\" of JSON where present)");
+                  "header.stamp or stamp of a typed message, \"time\" of JSON where present)")
+      ->check(field_name());
   sub->add_option("--time-source", cmd->time_source,
                   "receive: arrival on this host's clock (default); stamps: the messages' --time-field is the clock")
       ->check(CLI::IsMember({"receive", "stamps"}));
-  sub->add_option("--time-field", cmd->time_field, "With --time-source stamps: the field read as arrival time (default time)");
+  sub->add_option("--time-field", cmd->time_field, "With --time-source stamps: the field read as arrival time (default time)")
+      ->check(field_name());
   sub->add_option("--period", cmd->period, "Seconds between reports and /diagnostics (default 1)")
       ->check(in_range(0.01, 3600, "seconds"));
   sub->add_flag("--json", cmd->json, "One JSON object per topic per period instead of the table");
   sub->add_option("--diagnostics", cmd->diagnostics,
                   "Publish diagnostic_msgs/DiagnosticArray here, e.g. dds:/diagnostics, zenoh:diagnostics "
                   "(CDR), file:PATH (JSON lines); repeatable");
-  sub->add_option("--count,-n", cmd->count, "Stop after this many messages in all");
+  sub->add_option("--count,-n", cmd->count, "Stop after this many messages in all")
+      ->check(in_range(0, kMaxCount, "messages (0: no limit)"));
   sub->add_option("--duration", cmd->duration, "Stop after this many seconds")
       ->check(in_range(0, kMaxSeconds, "seconds"));
   sub->add_option("--idle-timeout", cmd->idle_timeout, "Stop after this many seconds without any message")

@@ -292,6 +292,17 @@ struct MonitorCommand {
     return finish_enforcer(run.outcome.exit_code());
   }
 
+  // Everything this run writes, by the option that names it.
+  std::vector<std::pair<std::string, std::string>> written_targets() const {
+    std::vector<std::pair<std::string, std::string>> out;
+    for (const auto& uri : outputs) out.emplace_back("--output", uri);
+    if (!stats_output.empty()) out.emplace_back("--stats-output", stats_output);
+    for (const auto& uri : health.uris) out.emplace_back("--diagnostics", uri);
+    if (!store.database.empty()) out.emplace_back("the results database", store.database);
+    if (!store.options.spool.empty()) out.emplace_back("--spool", store.options.spool);
+    return out;
+  }
+
   // An output that the input would read back (the same file, an
   // intersecting key expression, the same topic) feeds the monitor its own
   // verdicts without end.
@@ -539,6 +550,7 @@ struct MonitorCommand {
   int run() {
     if (!store.take_database(outputs)) return kUsage;
     if (outputs.empty()) outputs.push_back("-");
+    if (int status = refuse_shared_files(written_targets())) return status;
     const bool bag = !SyncFlags::named(inputs) && is_bag_input(inputs.at(0));
     if (!instances.options(iopts)) return kUsage;
     if (instances.given() && (bag || SyncFlags::named(inputs) || check.calls || typed.given() || group.given() ||
@@ -625,6 +637,7 @@ struct MonitorCommand {
     attach_results(input, popts, verdicts);
     runtime::Pipeline pipeline(properties, popts, [&](const engine::Verdict& v) { verdicts.put(v); });
     std::unique_ptr<runtime::InstancesFeed> instance_feed;
+    iopts.tick_at_end = clock.ticks_at_end(check.dense);  // an expiring instance ends as its sub-trace would
     if (instances.given()) instance_feed = std::make_unique<runtime::InstancesFeed>(properties, popts, verdicts, iopts);
     std::unique_ptr<runtime::ServiceCallFeed> call_feed;
     if (check.calls)

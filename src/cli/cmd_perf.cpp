@@ -7,6 +7,7 @@
 #include <string>
 
 #include "cli/commands.hpp"
+#include "cli/option_ranges.hpp"
 #include "cli/transport_flags.hpp"
 #include "cli/signals.hpp"
 #include "tools/perf/perf.hpp"
@@ -74,15 +75,19 @@ void add_role(PerfCommand& cmd, CLI::App& perf, const std::string& name, const s
     s->add_option("--rate", r.rate, name == "ping" ? "Pings per second, or max (next ping when the pong is back)"
                                                    : "Messages per second, or max")
         ->capture_default_str();
-    s->add_option("--duration", r.opts.duration, "Seconds to send for")->capture_default_str();
+    s->add_option("--duration", r.opts.duration, "Seconds to send for")
+        ->check(above_up_to(0, kMaxSeconds, "seconds"))
+        ->capture_default_str();
     s->add_flag("--inproc", r.opts.inproc,
                 name == "ping" ? "Answer the pings in this process (same session/participant)"
                                : "Subscribe in this process (same session/participant) and report its counts");
   } else {
     s->add_option("--duration", r.opts.duration,
                   "Stop this many seconds after the first message (default 0: at the end-of-stream marker)")
+        ->check(in_range(0, kMaxSeconds, "seconds"))
         ->capture_default_str();
     s->add_option("--idle-timeout", r.opts.idle_timeout, "Stop when nothing arrived for this many seconds")
+        ->check(above_up_to(0, kMaxSeconds, "seconds"))
         ->capture_default_str();
   }
   if (name == "pub")
@@ -91,15 +96,19 @@ void add_role(PerfCommand& cmd, CLI::App& perf, const std::string& name, const s
                 "kept for scripts (--no-dds-write-batch turns it off)");
   if (name == "ping")
     s->add_option("--warmup", r.opts.warmup, "Round trips sent in the first S seconds are not counted")
+        ->check(in_range(0, kMaxSeconds, "seconds"))
         ->capture_default_str();
   if (name == "sub" || name == "pub")
     s->add_option("--warmup", r.opts.warmup,
                   name == "sub" ? "msgs_per_s leaves out the first S seconds after the first message"
                                 : "With --inproc: msgs_per_s leaves out the first S seconds")
+        ->check(in_range(0, kMaxSeconds, "seconds"))
         ->capture_default_str();
   s->add_option("--timeout", r.opts.timeout, "Seconds to wait for a peer (match or first message)")
+      ->check(above_up_to(0, kMaxSeconds, "seconds"))
       ->capture_default_str();
   s->add_option("--report-interval", r.opts.report_interval, "Progress line period on stderr (0 = none)")
+      ->check(in_range(0, kMaxSeconds, "seconds"))
       ->capture_default_str();
   add_transport_options(*s, r.opts.transports);
 }

@@ -16,6 +16,7 @@
 #include <thread>
 
 #include "cli/commands.hpp"
+#include "cli/option_ranges.hpp"
 #include "cli/transport_flags.hpp"
 #include "cli/signals.hpp"
 #include "io/cdr_codec.hpp"
@@ -275,13 +276,16 @@ Runner register_replay(CLI::App& app) {
   sub->add_option("--to", cmd->to, "Endpoint: zenoh:KEYEXPR, dds:TOPIC, file:PATH")->required();
   sub->add_option("--rate", cmd->rate, "Messages per second, or max")->capture_default_str();
   sub->add_option("--wait-subscribers", cmd->wait_subscribers, "Subscribers to wait for before publishing")
+      ->check(in_range(0, 100000))
       ->capture_default_str();
-  sub->add_option("--wait-timeout", cmd->wait_timeout, "Seconds to wait for them")->capture_default_str();
+  sub->add_option("--wait-timeout", cmd->wait_timeout, "Seconds to wait for them")
+      ->check(in_range(0, kMaxSeconds, "seconds"))
+      ->capture_default_str();
   sub->add_flag("--no-eos", cmd->no_eos, "Do not send the end-of-stream marker");
   sub->add_option("--batch", cmd->batch,
                   "Messages per published sample (newline-separated; sequence numbers count samples)")
       ->capture_default_str()
-      ->check(CLI::Range(1, 1 << 20));
+      ->check(in_range(1, 1 << 20, "messages"));
   sub->add_flag("!--no-progress", cmd->progress, "No progress line on a terminal");
   sub->add_option("--latency-from", cmd->latency_from,
                   "Verdict endpoint of an `rvc monitor --all`: report publish-to-verdict latency percentiles");

@@ -13,6 +13,7 @@
 
 #include "cli/commands.hpp"
 #include "cli/option_ranges.hpp"
+#include "cli/option_rules.hpp"
 #include "cli/output_sinks.hpp"
 #include "cli/signals.hpp"
 #include "cli/sync_options.hpp"
@@ -165,6 +166,7 @@ Runner register_sync(CLI::App& app) {
   sub->add_option("--set-type-dir", cmd->set_type_dir,
                   "Write the --set-type definition here (DIR/pkg/msg/Name.msg) for subscribers' --msg-path");
   sub->add_option("--time-field", cmd->time_field, "JSON inputs: the field holding the stamp (seconds)")
+      ->check(field_name())
       ->capture_default_str();
   sub->add_option("--max-message-size", cmd->max_message_size, "Longest accepted message in bytes")
       ->check(in_range(1, kMaxMessageSize, "bytes"))

@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "cli/commands.hpp"
+#include "cli/option_ranges.hpp"
 #include "tools/timescales.hpp"
 #include "transport/output_file.hpp"
 
@@ -69,10 +70,17 @@ Runner register_timescales(CLI::App& app) {
   sub->add_option("family", cmd->opts.family,
                   "AbsentAQ AbsentBQR AbsentBR AlwaysAQ AlwaysBQR AlwaysBR RecurBQR RecurGLB RespondBQR RespondGLB")
       ->required();
-  sub->add_option("--lbound", cmd->opts.lbound, "Lower time bound (default: 30% of ubound, as published)");
-  sub->add_option("--ubound", cmd->opts.ubound, "Upper time bound")->capture_default_str();
-  sub->add_option("--duration", cmd->opts.duration, "Number of steps (lines)")->capture_default_str();
-  sub->add_option("--seed", cmd->opts.seed, "Random seed: same seed, same bytes")->capture_default_str();
+  sub->add_option("--lbound", cmd->opts.lbound, "Lower time bound (default: 30% of ubound, as published)")
+      ->check(in_range(0, 1e9, "steps"));
+  sub->add_option("--ubound", cmd->opts.ubound, "Upper time bound")
+      ->check(in_range(1, 1e9, "steps"))
+      ->capture_default_str();
+  sub->add_option("--duration", cmd->opts.duration, "Number of steps (lines)")
+      ->check(in_range(0, kMaxCount, "lines"))
+      ->capture_default_str();
+  sub->add_option("--seed", cmd->opts.seed, "Random seed: same seed, same bytes")
+      ->check(in_range(0, kMaxCount))
+      ->capture_default_str();
   sub->add_option("--output,-o", cmd->output, "Trace file (- for stdout)")->capture_default_str();
   sub->add_option("--properties-out", cmd->properties_out, "Also write the formula as a properties file");
   sub->add_flag("--formula", cmd->formula_only, "Print only the formula and exit");

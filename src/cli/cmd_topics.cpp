@@ -8,6 +8,7 @@
 #include <string>
 
 #include "cli/commands.hpp"
+#include "cli/option_ranges.hpp"
 #include "cli/transport_flags.hpp"
 #include "transport/zenoh/rmw_zenoh_endpoint.hpp"
 
@@ -84,7 +85,7 @@ Runner register_topics(CLI::App& app) {
   sub->add_flag("--show-types,-t", cmd->show_types, "Print each topic's type: /topic [pkg/msg/Name]");
   sub->add_flag("--verbose,-v", cmd->verbose, "Published and subscribed topics with their endpoint counts");
   sub->add_option("--wait", cmd->wait, "Seconds to wait for the graph's answers (default 2)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(in_range(0, kMaxSeconds, "seconds"));
   sub->footer("Exit status: 0 topics listed, 5 Zenoh failed, 6 no topic announced within --wait.");
   add_zenoh_options(*sub, cmd->transports.zenoh);
   return [cmd] { return cmd->run(); };

@@ -5,13 +5,14 @@
 #include <stdexcept>
 
 #include "cli/transport_flags.hpp"
+#include "cli/option_ranges.hpp"
 
 namespace rvc::cli {
 
 void add_dds_options(CLI::App& app, transport::DdsOptions& o) {
   const std::string group = "DDS (dds:TOPIC endpoints)";
   app.add_option("--domain", o.domain, "DDS domain id (0..232)")
-      ->check(CLI::Range(0, 232))
+      ->check(in_range(0, kMaxDomain))
       ->capture_default_str()
       ->group(group);
   app.add_option("--partition", o.partition, "DDS partition (default: none, as ROS 2)")->group(group);

@@ -5,6 +5,9 @@
 
 #include <CLI/CLI.hpp>
 
+#include "cli/option_ranges.hpp"
+#include "cli/option_rules.hpp"
+
 #include <cstdio>
 #include <string>
 
@@ -21,15 +24,16 @@ struct InstanceFlags {
   void add_to(CLI::App& app) {
     app.add_option("--instances-by", by,
                    "One monitor instance per value of this field (a path: id, vehicle.id); each verdict carries "
-                   "\"instance\":{\"FIELD\":VALUE} (docs/semantics.md, \"Parametric instances\")");
+                   "\"instance\":{\"FIELD\":VALUE} (docs/semantics.md, \"Parametric instances\")")
+        ->check(field_name());
     app.add_option("--instance-expiry", expiry,
                    "With --instances-by: remove an instance whose last message is more than SECONDS (stream time; "
                    "messages for a trace without times) before the message being routed; its key then starts afresh")
-        ->check(CLI::PositiveNumber);
+        ->check(above_up_to(0, kMaxExpiry, "seconds (or messages)"));
     app.add_option("--max-instances", max_instances,
                    "With --instances-by: the most live instances (default 100000); messages of further keys are "
                    "dropped (\"instance_limit\", exit 3)")
-        ->check(CLI::PositiveNumber);
+        ->check(in_range(1, kMaxInstances, "instances"));
   }
   // The options, or false (usage error printed): an empty part of the path,
   // or --instance-expiry/--max-instances without --instances-by.

@@ -1,7 +1,11 @@
 #include "cli/output_sinks.hpp"
 
+#include <sys/stat.h>
+
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
+#include <system_error>
 
 #include "cli/commands.hpp"
 
@@ -35,6 +39,71 @@ int refuse_input_copies(const std::vector<std::string>& outputs, const std::stri
                    uri.c_str(), input.c_str());
       return kUsage;
     }
+  return 0;
+}
+
+std::string written_file(const std::string& uri) {
+  if (uri.empty() || uri == "-") return "";
+  if (uri.rfind("sqlite:", 0) == 0) return uri.substr(7);
+  if (uri.rfind("postgres", 0) == 0) return "";
+  std::string scheme;
+  try {
+    scheme = transport::scheme_of(uri);
+  } catch (const std::invalid_argument&) {
+    return "";  // refused when it is opened, with its own reason
+  }
+  if (scheme == "file") return uri.rfind("file:", 0) == 0 ? uri.substr(5) : uri;
+  if (scheme == "mcap") {
+    std::string path = uri.substr(uri.find(':') + 1);
+    if (const size_t q = path.rfind("?inputs="); q != std::string::npos) path.resize(q);  // an output's option
+    return path;
+  }
+  return "";
+}
+
+namespace {
+
+// Where writing a file that does not exist yet creates it: a dangling
+// symlink is followed to its target, then the path is made absolute with its
+// existing part resolved.
+std::filesystem::path where_written(const std::string& path, std::error_code& ec) {
+  namespace fs = std::filesystem;
+  fs::path p = fs::absolute(path, ec);
+  std::error_code absent;  // (no such file: nothing to follow)
+  for (int hops = 0; !ec && hops < 40 && fs::is_symlink(fs::symlink_status(p, absent)); ++hops) {
+    const fs::path target = fs::read_symlink(p, ec);
+    p = target.is_absolute() ? target : p.parent_path() / target;
+  }
+  return ec ? p : fs::weakly_canonical(p, ec);
+}
+
+bool same_file(const std::string& a, const std::string& b) {
+  struct stat sa, sb;
+  const bool ea = ::stat(a.c_str(), &sa) == 0, eb = ::stat(b.c_str(), &sb) == 0;
+  // Two writers on one device (/dev/null, a terminal) do not corrupt a file.
+  if (ea && eb) return sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino && S_ISREG(sa.st_mode);
+  if (ea != eb) return false;
+  std::error_code ec1, ec2;
+  const auto ca = where_written(a, ec1), cb = where_written(b, ec2);
+  return !ec1 && !ec2 ? ca == cb : a == b;
+}
+
+}  // namespace
+
+int refuse_shared_files(const std::vector<std::pair<std::string, std::string>>& targets) {
+  for (size_t i = 0; i < targets.size(); ++i) {
+    const std::string fi = written_file(targets[i].second);
+    if (fi.empty()) continue;
+    for (size_t j = i + 1; j < targets.size(); ++j) {
+      const std::string fj = written_file(targets[j].second);
+      if (fj.empty() || !same_file(fi, fj)) continue;
+      std::fprintf(stderr, "rvc: %s '%s' and %s '%s' name the same file: each would overwrite the other; give "
+                           "each output a file of its own\n",
+                   targets[i].first.c_str(), targets[i].second.c_str(), targets[j].first.c_str(),
+                   targets[j].second.c_str());
+      return kUsage;
+    }
+  }
   return 0;
 }
 

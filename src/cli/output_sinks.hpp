@@ -6,6 +6,7 @@
 
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "transport/endpoint.hpp"
@@ -24,5 +25,18 @@ int open_outputs(const std::vector<std::string>& uris, const transport::Transpor
 // lines, live topics) nothing would be copied, so the run is refused instead.
 // Returns 0, or kUsage after printing why.
 int refuse_input_copies(const std::vector<std::string>& outputs, const std::string& input);
+
+// The file an output writes (file:PATH, a plain path, mcap:PATH, sqlite:PATH,
+// a spool file), or "" (stdout, a topic, a PostgreSQL database).
+std::string written_file(const std::string& uri);
+
+// Two outputs of one run (verdicts, --stats-output, --diagnostics, the
+// results database and its spool) that name one file would overwrite each
+// other (an MCAP file that is no longer MCAP, verdict lines lost): refused at
+// start, before anything is written. One file: the same inode when it exists
+// (hard links, symlinks, ./v.mcap and v.mcap), else the same path once made
+// absolute with its existing part resolved. Each target is {option, uri}.
+// Returns 0, or kUsage after printing both.
+int refuse_shared_files(const std::vector<std::pair<std::string, std::string>>& targets);
 
 }  // namespace rvc::cli

@@ -16,12 +16,37 @@ InstancesFeed::InstancesFeed(const std::vector<engine::PropertySpec>& properties
 
 InstancesFeed::~InstancesFeed() = default;
 
+// The key string without writing it into the document's string buffer: that
+// buffer holds one unescaped copy of each string of the document (simdjson
+// sizes it so), and the instance's Pipeline unescapes every string again after
+// the object is reset; a key read there too overflowed it once the key was
+// about a third of the buffer (a 54,700-character key: heap corruption).
+// A key without escapes is its raw text; one with escapes is unescaped by a
+// parser of its own, in a buffer of its own.
+bool InstancesFeed::unescape_key(std::string_view raw, std::string_view& out) {
+  while (!raw.empty() && (raw.back() == ' ' || raw.back() == '\t' || raw.back() == '\r' || raw.back() == '\n'))
+    raw.remove_suffix(1);
+  if (raw.size() < 2 || raw.front() != '"' || raw.back() != '"') return false;
+  const std::string_view inner = raw.substr(1, raw.size() - 2);
+  if (inner.find('\\') == std::string_view::npos) {  // (UTF-8 was validated with the whole document)
+    out = inner;
+    return true;
+  }
+  key_scratch_.assign(raw.data(), raw.size());
+  key_scratch_.append(simdjson::SIMDJSON_PADDING, ' ');
+  simdjson::ondemand::document doc;
+  if (key_parser_.iterate(key_scratch_.data(), raw.size(), key_scratch_.size()).get(doc)) return false;
+  return !doc.get_string().get(out);
+}
+
 void InstancesFeed::report(const std::string& text) {
   if (reported_++ < options_.max_reported) std::fprintf(stderr, "rvc: %s\n", text.c_str());
 }
 
 io::ReadResult InstancesFeed::on_object(const io::Position& where, simdjson::ondemand::object object) {
   current_ = nullptr;
+  current_fresh_ = false;
+  current_now_ = std::nan("");
   pending_rejection_.clear();
   pending_line_ = where.number();
   ++ordinal_;
@@ -62,11 +87,11 @@ io::ReadResult InstancesFeed::on_object(const io::Position& where, simdjson::ond
       }
       if (type.value_unsafe() == simdjson::ondemand::json_type::string) {
         std::string_view s;
-        if (value.get_string().get(s)) {
+        if (!unescape_key(value.raw_json_token(), s)) {
           json_error_ = "invalid string";
           return io::ReadResult::Malformed;
         }
-        key = "s" + std::string(s);
+        key.assign(1, 's').append(s);  // (not "s" + std::string(s): GCC 12 warns falsely, -Wrestrict)
         key_json.clear();
         io::append_json_string(key_json, s);
       } else if (type.value_unsafe() == simdjson::ondemand::json_type::number) {
@@ -103,7 +128,7 @@ io::ReadResult InstancesFeed::on_object(const io::Position& where, simdjson::ond
     return io::ReadResult::Malformed;
   }
   if (!pending_rejection_.empty()) return io::ReadResult::Pending;  // counted at commit() (it may be broken)
-  if (instance_options_.expiry > 0) expire_before(now, ordinal_, !std::isnan(now));
+  if (instance_options_.expiry > 0) expire_before(now, ordinal_);
   const uint64_t created_before = created_;
   current_ = instance_for(key, key_json);
   current_fresh_ = created_ != created_before;
@@ -111,9 +136,7 @@ io::ReadResult InstancesFeed::on_object(const io::Position& where, simdjson::ond
     pending_rejection_.clear();
     return io::ReadResult::Pending;  // dropped at commit(): the limit
   }
-  if (!std::isnan(now)) current_->last_time = now;
-  current_->last_ordinal = ordinal_;
-  lru_.splice(lru_.end(), lru_, current_->lru);
+  current_now_ = now;  // the instance is refreshed at commit(), if it checks the message
   io::ReadResult result = current_->pipeline->on_object(where, object);
   if (result != io::ReadResult::Pending) drop_fresh();  // broken JSON: the reader reports it to us
   return result;
@@ -143,46 +166,87 @@ InstancesFeed::Instance* InstancesFeed::instance_for(const std::string& key, con
     outputs_.put(v);
     outputs_.set_mark({});
   });
+  inst->last_ordinal = ordinal_;
   inst->lru = lru_.insert(lru_.end(), raw);
+  inst->untimed = untimed_.insert(untimed_.end(), raw);
   ++created_;
   instances_.emplace(key, std::move(inst));
   return raw;
 }
 
-void InstancesFeed::expire_before(double now, uint64_t ordinal, bool has_time) {
+void InstancesFeed::expire_before(double now, uint64_t ordinal) {
   const double s = instance_options_.expiry;
-  while (!lru_.empty()) {
-    Instance& oldest = *lru_.front();
-    // Stream time when both have it; else messages (a trace without times).
-    const bool old = has_time && !std::isnan(oldest.last_time) ? now - oldest.last_time > s
-                                                                : double(ordinal - oldest.last_ordinal) > s;
-    if (!old) break;
-    retire(oldest);
+  // Stream time for instances that have one (a message with a time); else messages.
+  if (!std::isnan(now))
+    while (!by_time_.empty() && now - by_time_.begin()->first > s) retire(*by_time_.begin()->second);
+  while (!untimed_.empty() && double(ordinal - untimed_.front()->last_ordinal) > s) retire(*untimed_.front());
+}
+
+// The instance checked the pending message (at time `now`, NaN: none).
+void InstancesFeed::touch(Instance& inst, double now) {
+  inst.last_ordinal = ordinal_;
+  lru_.splice(lru_.end(), lru_, inst.lru);
+  if (!std::isnan(now)) {
+    if (std::isnan(inst.last_time)) untimed_.erase(inst.untimed);
+    else by_time_.erase(inst.timed);
+    inst.last_time = now;
+    inst.timed = by_time_.emplace(now, &inst);
+  } else if (std::isnan(inst.last_time)) {
+    untimed_.splice(untimed_.end(), untimed_, inst.untimed);
   }
 }
 
+// An instance ends: what the end of its sub-trace decides first (its last
+// segment's tick, bounded-future horizons), as a check of the sub-trace
+// ends; its counts stay in the run's.
 void InstancesFeed::retire(Instance& inst) {
-  inst.pipeline->end_of_input();
-  inst.pipeline->finish_report();
-  const PipelineStats& s = inst.pipeline->stats();
+  Pipeline& p = *inst.pipeline;
+  p.end_of_input();
+  if (instance_options_.tick_at_end) p.tick(p.last_stamp());  // NaN (nothing taken): no tick
+  p.settle();
+  p.finish_report();
+  fold(p);
+  retired_violations_ += p.violations();
+  ++expired_;
+  remove(inst);
+}
+
+void InstancesFeed::fold(const Pipeline& pipeline) {
+  const PipelineStats& s = pipeline.stats();
   retired_.accepted += s.accepted;
   retired_.rejected += s.rejected;
   retired_.warnings += s.warnings;
   retired_.by_layout += s.by_layout;
   retired_.late_to_clock += s.late_to_clock;
-  retired_violations_ += inst.pipeline->violations();
-  ++expired_;
+}
+
+void InstancesFeed::remove(Instance& inst) {
+  if (std::isnan(inst.last_time)) untimed_.erase(inst.untimed);
+  else by_time_.erase(inst.timed);
   lru_.erase(inst.lru);
   instances_.erase(inst.key);  // destroys inst
 }
 
 void InstancesFeed::commit() {
   if (current_) {
-    Pipeline& p = *current_->pipeline;
+    Instance& inst = *current_;
+    const bool fresh = current_fresh_;
     current_ = nullptr;
+    current_fresh_ = false;
+    Pipeline& p = *inst.pipeline;
+    const uint64_t checked_before = p.stats().accepted;
     p.commit();
-    const double t = p.last_stamp();
-    if (!std::isnan(t) && (std::isnan(last_stamp_) || t > last_stamp_)) last_stamp_ = t;
+    if (p.stats().accepted > checked_before) {
+      touch(inst, current_now_);
+      const double t = p.last_stamp();
+      if (!std::isnan(t) && (std::isnan(last_stamp_) || t > last_stamp_)) last_stamp_ = t;
+    } else if (fresh) {
+      // Rejected by the instance it made (a bad time, a --strict type error):
+      // no instance for it, so garbage under many keys takes no place.
+      fold(p);  // (its rejection, reported by the instance)
+      --created_;
+      remove(inst);
+    }
     return;
   }
   if (!pending_rejection_.empty()) {
@@ -206,8 +270,7 @@ void InstancesFeed::discard() {
 void InstancesFeed::drop_fresh() {
   if (current_ && current_fresh_) {
     --created_;
-    lru_.erase(current_->lru);
-    instances_.erase(current_->key);
+    remove(*current_);
   }
   current_ = nullptr;
   current_fresh_ = false;
@@ -273,6 +336,14 @@ void InstancesFeed::add_stats(io::JsonObject& out) const {
 
 void InstancesFeed::tick_each_at_end() {
   for (auto* inst : lru_) inst->pipeline->tick(inst->pipeline->last_stamp());
+}
+
+void InstancesFeed::end_of_input() {
+  for (auto* inst : lru_) inst->pipeline->end_of_input();
+}
+
+void InstancesFeed::settle() {
+  for (auto* inst : lru_) inst->pipeline->settle();
 }
 
 }  // namespace rvc::runtime

@@ -13,14 +13,20 @@
 // Counts: received = checked + rejected + dropped. A message without the
 // key (or with a key that is no string or number) is rejected ("no key");
 // with --max-instances N, a message whose key would make instance N+1 is
-// dropped ("instance_limit": exit 3, the run goes on). --instance-expiry S
-// removes an instance whose last message is more than S (stream time)
-// before the message being routed; the key's next message starts a fresh
-// instance (steps and history from zero).
+// dropped ("instance_limit": exit 3, the run goes on). Only a message its
+// instance checks makes or refreshes an instance: one it rejects (a bad time,
+// a --strict type error) leaves none behind and no place taken.
+// --instance-expiry S removes an instance whose last checked message is more
+// than S (stream time) before the message being routed (an instance whose
+// messages had no time: more than S messages before); the key's next message
+// starts a fresh instance (steps and history from zero). An instance that
+// ends (expiry, end of input) settles what its sub-trace's end decides
+// (bounded future), as a check of that sub-trace does.
 #pragma once
 
 #include <cstdint>
 #include <list>
+#include <map>
 #include <memory>
 #include <string>
 #include <unordered_map>
@@ -35,6 +41,7 @@ struct InstanceOptions {
   std::vector<std::string> key_path;  // "vehicle.id" -> {"vehicle", "id"}
   double expiry = 0;                  // seconds of stream time (<= 0: never)
   size_t max_instances = 100000;      // live instances at once
+  bool tick_at_end = false;           // dense, --clock auto: an ending instance ticks at its last stamp
 };
 
 class InstancesFeed final : public io::JsonlHandler, public Feed {
@@ -67,6 +74,12 @@ class InstancesFeed final : public io::JsonlHandler, public Feed {
   // Dense time, --clock auto: each instance ticks at its own last stamp (its
   // last message's segment gets its verdict, as in a check of its sub-trace).
   void tick_each_at_end();
+  // The loop's tick at a file's end: instances move with their own messages
+  // (no --clock), so each ticks at its own last stamp, as tick_each_at_end.
+  void tick(double) override { tick_each_at_end(); }
+  void end_of_input() override;
+  // Bounded future: every live instance settles its last horizon.
+  void settle() override;
   uint64_t refused_keys() const { return refused_keys_; }
 
  private:
@@ -74,15 +87,21 @@ class InstancesFeed final : public io::JsonlHandler, public Feed {
     std::string key;
     std::string mark;  // ,"instance":{...}: the members its verdicts get
     std::unique_ptr<Pipeline> pipeline;
-    double last_time = std::numeric_limits<double>::quiet_NaN();
+    double last_time = std::numeric_limits<double>::quiet_NaN();  // of its last checked message
     uint64_t last_ordinal = 0;
-    std::list<Instance*>::iterator lru;
+    std::list<Instance*>::iterator lru;                  // in lru_
+    std::list<Instance*>::iterator untimed;              // in untimed_ while last_time is NaN
+    std::multimap<double, Instance*>::iterator timed;    // in by_time_ once it has a time
   };
   Instance* instance_for(const std::string& key, const std::string& key_json);
-  void expire_before(double now, uint64_t ordinal, bool has_time);
+  void expire_before(double now, uint64_t ordinal);
+  void touch(Instance& instance, double now);
   void retire(Instance& instance);
+  void remove(Instance& instance);
+  void fold(const Pipeline& pipeline);
   void drop_fresh();
   void report(const std::string& text);
+  bool unescape_key(std::string_view raw, std::string_view& out);
 
   std::vector<engine::PropertySpec> properties_;
   PipelineOptions options_;
@@ -90,9 +109,16 @@ class InstancesFeed final : public io::JsonlHandler, public Feed {
   InstanceOptions instance_options_;
   std::string key_name_;  // the path as written ("vehicle.id"): the instance object's member name
   std::unordered_map<std::string, std::unique_ptr<Instance>> instances_;
-  std::list<Instance*> lru_;  // least recently fed first
+  // Least recently checked first: all instances (the order they end in), and
+  // those whose messages had no time (they expire by message count). Those
+  // with a time expire by it, oldest time first (by_time_): times of
+  // different keys need not come in order, so one instance whose last time
+  // is late cannot keep the others from expiring.
+  std::list<Instance*> lru_, untimed_;
+  std::multimap<double, Instance*> by_time_;
   Instance* current_ = nullptr;  // the pending message's instance
   bool current_fresh_ = false;   // ... made by that message
+  double current_now_ = std::numeric_limits<double>::quiet_NaN();  // ... and its time, for expiry
   std::string pending_rejection_;
   uint64_t pending_line_ = 0;
   uint64_t ordinal_ = 0;
@@ -103,6 +129,8 @@ class InstancesFeed final : public io::JsonlHandler, public Feed {
   uint64_t reported_ = 0;
   double last_stamp_ = std::numeric_limits<double>::quiet_NaN();
   std::string json_error_;
+  simdjson::ondemand::parser key_parser_;  // unescapes keys with escapes (unescape_key)
+  std::string key_scratch_;
   std::unordered_map<std::string, bool> refused_;  // keys refused by the limit (counted once each)
   mutable PipelineStats stats_;
 };

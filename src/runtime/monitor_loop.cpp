@@ -97,6 +97,10 @@ std::string MonitorLoop::stats_json() const {
       .add("rejected", p.rejected);
   io::JsonObject dropped;
   feed_.add_dropped(dropped);
+  if (failed_in_flight_) {  // the message whose verdict could not be written (one message per frame)
+    const uint64_t received = total(&transport::SeqCounters::received), taken = feed_.received() + filtered_;
+    if (received > taken) dropped.add("output_failed", received - taken);
+  }
   out.add("dropped", dropped)
       .add("warnings", p.warnings)
       .add("by_layout", p.by_layout)
@@ -228,7 +232,12 @@ void MonitorLoop::handle(const transport::Frame& f) {
     }
     if (options_.filter->projecting() && options_.filter->project(payload, projected_)) payload = projected_;
   }
-  feed_.feed_keyed(f.input, f.key, payload, f.seq ? f.seq : counters.received);
+  try {
+    feed_.feed_keyed(f.input, f.key, payload, f.seq ? f.seq : counters.received);
+  } catch (...) {
+    failed_in_flight_ = true;  // counted in stats_json(), whatever ends the run
+    throw;
+  }
 }
 
 void MonitorLoop::on_schedule(std::chrono::steady_clock::time_point now) {

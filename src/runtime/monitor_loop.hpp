@@ -181,6 +181,10 @@ class MonitorLoop {
   EndReason end_ = EndReason::SourceClosed;
   std::string final_stats_;
   uint64_t filtered_ = 0;   // messages the filter kept from the monitor
+  // An output failed while a message was being checked (a verdict it made
+  // could not be written): that message was received but neither checked
+  // nor rejected; it is counted as dropped ("output_failed").
+  bool failed_in_flight_ = false;
   std::string projected_;   // the message as the filter projected it
   std::chrono::steady_clock::time_point last_stats_{}, last_record_{};
   StreamClock clock_{ClockKind::Off};

@@ -5,15 +5,19 @@
 // rvc changes only its own databases: a file it creates is stamped with
 // PRAGMA application_id = kApplicationId in the transaction that creates its
 // tables; an existing file is used only if it has that stamp, or (made by an
-// rvc before the stamp) exactly rvc's tables. Anything else (another
-// application's database, an empty file, a file that is not SQLite) is
-// refused before a byte of it changes: no journal mode, no tables.
+// rvc before the stamp) exactly rvc's tables with rvc's columns. Anything
+// else (another application's database, even one whose tables share rvc's
+// names; an empty file; a file that is not SQLite) is refused before a byte
+// of it changes: that is decided on a read-only, immutable connection (no
+// lock, no journal, no -wal/-shm files), before the file is opened for
+// writing; no journal mode, no stamp, no tables.
 #include <fcntl.h>
 #include <sqlite3.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstdio>
 #include <chrono>
 #include <cstdlib>
 #include <cstring>
@@ -29,10 +33,33 @@ namespace {
 
 constexpr int kApplicationId = 0x72766331;  // "rvc1"
 
-// The tables of an rvc results database, as rvc before the stamp made them.
-const std::set<std::string>& rvc_tables() {
-  static const std::set<std::string> tables{"runs", "properties", "verdicts", "violations", "counters"};
+// The tables of an rvc results database, as rvc before the stamp made them,
+// with the columns they had then (later ones are added: added_columns()).
+const std::map<std::string, std::set<std::string>>& rvc_tables() {
+  static const std::map<std::string, std::set<std::string>> tables{
+      {"runs", {"run", "command", "inputs", "time_model", "started_at", "ended_at", "exit_status", "end_reason",
+                "counters"}},
+      {"properties", {"run", "name", "spec"}},
+      {"verdicts", {"id", "run", "property", "time", "value", "wall"}},
+      {"violations", {"id", "run", "property", "time", "wall", "witness"}},
+      {"counters", {"id", "run", "wall", "counters"}}};
   return tables;
+}
+
+// file:PATH?immutable=1 for sqlite3_open_v2 (SQLITE_OPEN_URI): '%', '?' and
+// '#' in the path are escaped.
+std::string immutable_uri(const std::string& path) {
+  std::string out = "file:";
+  for (const char c : path) {
+    if (c == '%' || c == '?' || c == '#') {
+      char buf[4];
+      std::snprintf(buf, sizeof buf, "%%%02X", static_cast<unsigned char>(c));
+      out += buf;
+    } else {
+      out += c;
+    }
+  }
+  return out + "?immutable=1";
 }
 
 class SqliteDatabase final : public Database {
@@ -40,6 +67,26 @@ class SqliteDatabase final : public Database {
   SqliteDatabase(const std::string& path, bool read_only) : path_(path), read_only_(read_only) {
     bool created = false;
     if (!read_only) created = create_if_missing();
+    if (!created) {
+      // Whose file it is, decided before it is opened (for writing, or for
+      // reading a WAL file, which makes -wal and -shm files).
+      if (sqlite3_open_v2(immutable_uri(path).c_str(), &db_, SQLITE_OPEN_READONLY | SQLITE_OPEN_URI, nullptr) !=
+          SQLITE_OK) {
+        std::string what = db_ ? sqlite3_errmsg(db_) : "out of memory";
+        sqlite3_close(db_);
+        db_ = nullptr;
+        throw DbError("cannot open " + describe() + ": " + what);
+      }
+      try {
+        check_ours();
+      } catch (...) {
+        sqlite3_close(db_);
+        db_ = nullptr;
+        throw;
+      }
+      sqlite3_close(db_);
+      db_ = nullptr;
+    }
     const int flags = read_only ? SQLITE_OPEN_READONLY : SQLITE_OPEN_READWRITE;
     if (sqlite3_open_v2(path.c_str(), &db_, flags, nullptr) != SQLITE_OK) {
       std::string what = db_ ? sqlite3_errmsg(db_) : "out of memory";
@@ -54,8 +101,6 @@ class SqliteDatabase final : public Database {
       exec("PRAGMA application_id=" + std::to_string(kApplicationId));
       for (const auto& sql : schema_statements(Dialect::Sqlite)) exec(sql);
       exec("COMMIT");
-    } else {
-      check_ours();
     }
     if (read_only) return;  // the dashboard changes nothing, not even the journal mode
     exec("PRAGMA journal_mode=WAL");
@@ -219,13 +264,24 @@ class SqliteDatabase final : public Database {
     }
     std::set<std::string> names;
     for (const auto& row : tables) names.insert(row[0]);
-    if (app == 0 && names == rvc_tables()) return;  // made by an rvc before the stamp
+    if (app == 0 && older_rvc(names)) return;  // made by an rvc before the stamp
     std::string listed;
     for (const auto& name : names) listed += (listed.empty() ? "" : ", ") + name;
     throw DbError(describe() + " is not an rvc results database (" +
                   (app ? "application_id " + std::to_string(app) + ", " : std::string()) +
                   (names.empty() ? std::string("no tables") : "tables: " + listed) +
                   "): refusing to change it (name a new file for rvc's results)");
+  }
+
+  // rvc's table names, each with (at least) the columns rvc gave it.
+  bool older_rvc(const std::set<std::string>& names) {
+    if (names.size() != rvc_tables().size()) return false;
+    for (const auto& [table, columns] : rvc_tables()) {
+      if (!names.count(table)) return false;
+      for (const std::string& column : columns)
+        if (!has_column(table, column)) return false;
+    }
+    return true;
   }
 
   std::string path_;

@@ -26,6 +26,7 @@ Exit status: 0 every bag checked and held; 1 a property was violated in some bag
 (its results are not in the store); 6 no bag found.
 """
 import argparse
+import hashlib
 import json
 import os
 import re
@@ -117,7 +118,14 @@ def open_output(path):
 
 
 def verdicts_path(out_dir, bag):
-    return os.path.join(out_dir, re.sub(r"[^A-Za-z0-9._-]", "_", bag.strip("/")) + ".jsonl")
+    """DIR/<bag path, readable>-<hash>.jsonl: one file per bag whatever the names. The readable part alone
+    is not one-to-one (`a b.mcap`, `a_b.mcap` and `a/b.mcap` all read `a_b.mcap`), so it is followed by a
+    short hash of the bag's exact path; long paths keep their end (the bag's own name) readable."""
+    readable = re.sub(r"[^A-Za-z0-9._-]", "_", bag.strip("/"))
+    if len(readable) > 180:  # a file name has at most 255 bytes
+        readable = readable[-180:]
+    digest = hashlib.sha256(os.fsencode(bag)).hexdigest()[:12]
+    return os.path.join(out_dir, "%s-%s.jsonl" % (readable, digest))
 
 
 def check_bag(rvc, bag, check_args, store, out_dir=None, timeout=None):
@@ -260,6 +268,9 @@ def main(argv=None):
     # Before any bag runs: a file rvc-batch would write over that it did not create is refused.
     planned = ([args.summary] if args.summary else []) + \
         ([verdicts_path(args.out_dir, b) for b in bags] if args.out_dir else [])
+    if len(set(planned)) != len(planned):  # (a hash collision: never seen, but never silent)
+        say("two bags would share one --out-dir file: name them differently")
+        return 2
     for path in planned:
         problem = not_ours(path)
         if problem:

@@ -12,6 +12,7 @@ import os
 import sqlite3
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -21,6 +22,9 @@ _spec = importlib.util.spec_from_file_location("example_bags", os.path.join(ROOT
                                                                            "example_bags.py"))
 eb = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(eb)
+_tool_spec = importlib.util.spec_from_file_location("rvc_batch", TOOL)
+rb = importlib.util.module_from_spec(_tool_spec)
+_tool_spec.loader.exec_module(rb)
 
 COUNT, MESSAGES = 200, 20
 
@@ -147,7 +151,7 @@ def test_files_it_did_not_create_are_never_written_over(rvc, bags, tmp_path):
     assert foreign.read_text() == "precious\n" and not store.exists()
     out_dir = tmp_path / "out"
     out_dir.mkdir()
-    target = out_dir / (one.strip("/").replace("/", "_") + ".jsonl")
+    target = Path(rb.verdicts_path(str(out_dir), one))
     target.write_text("precious\n")
     r = batch(rvc, one, "--store", "sqlite:%s" % store, "--out-dir", str(out_dir), "--no-progress",
               "--", "--spec", "{data < 1000}")
@@ -222,3 +226,34 @@ def test_postgresql_store_one_run_per_bag(rvc, bags, postgres, tmp_path):
         verdicts = sql("SELECT property, time, value FROM verdicts WHERE run = '%s' ORDER BY id" % x["run"])
         got = [(v["property"], float(v["time"]), int(v["value"])) for v in verdicts]
         assert (x["exit_status"], got) == (want[bag][0], [(p, float(t), int(v)) for p, t, v in want[bag][1]]), bag
+
+
+def test_one_verdict_file_per_bag_whatever_the_names(rvc, tmp_path):
+    """Issue 36: `a b.mcap`, `a_b.mcap` and `sub/a b.mcap` shared one --out-dir file, each overwriting the
+    last. Oracle: `rvc check` of each bag alone."""
+    pytest.importorskip("dask.distributed", reason="dask[distributed] (PyPI) not installed")
+    from rosbags.rosbag2 import StoragePlugin, Writer
+    from rosbags.typesys import Stores, get_typestore
+    ts = get_typestore(Stores.ROS2_HUMBLE)
+    F = ts.types["std_msgs/msg/Float64"]
+    top = tmp_path / "bags"
+    (top / "sub").mkdir(parents=True)
+    names = ["a b.mcap", "a_b.mcap", "sub/a b.mcap"]
+    for k, name in enumerate(names):
+        folder = tmp_path / f"w{k}"
+        with Writer(folder, version=8, storage_plugin=StoragePlugin.MCAP) as w:
+            c = w.add_connection("/speed", F.__msgtype__, typestore=ts)
+            for j in range(5):  # bag k exceeds 10 at step k+1: each bag's verdicts differ
+                w.write(c, 1_000 + j, ts.serialize_cdr(F(data=20.0 if j == k + 1 else 1.0), F.__msgtype__))
+        os.rename(next(folder.glob("*.mcap")), top / name)
+    spec = ["--", "--spec", "{data < 10}", "--all"]
+    out = tmp_path / "out"
+    r = batch(rvc, str(top), "--store", "sqlite:%s" % (tmp_path / "s.db"), "--out-dir", str(out), "--no-progress",
+              "--workers", "1", *spec)
+    assert r.returncode == 1, r.stderr
+    files = sorted(os.listdir(out))
+    assert len(files) == 3, files
+    for name in names:
+        bag = str(top / name)
+        want = subprocess.run([rvc, "check", bag, *spec[1:]], capture_output=True, text=True).stdout
+        assert want and open(rb.verdicts_path(str(out), bag)).read() == want, name

@@ -121,3 +121,16 @@ def test_fields_and_constants_are_checked_against_the_type(rvc):
     r = subprocess.run([rvc, "monitor", "--spec", "{report}", "--input", "file:x.jsonl", "--type", GEAR],
                        capture_output=True, text=True, timeout=30)
     assert r.returncode == 2 and "--type reads typed samples from a dds: topic" in r.stderr, r.stderr
+
+
+def test_bounded_future_on_typed_samples_equals_check_on_json(rvc, tmp_path, zenoh_mod, store):
+    """`eventually` on `monitor --type` was refused at start: "no field 'rvc-end-of-stream' in ..." (issue 36)."""
+    samples = gear_samples(store, 120, seed=4)
+    spec = "{report == REVERSE} -> eventually[0:3]{report: PARK}"
+    rc, out, err = run_monitor(rvc, zenoh_mod, spec, [raw for raw, _ in samples])
+    stats = json.loads(err.strip().splitlines()[-1])
+    assert stats["received"] == 120 and stats["checked"] == 120, err
+    want_rc, want = check_json(rvc, tmp_path, "{report == %d} -> eventually[0:3]{report: %d}" % (REVERSE, PARK),
+                               [o for _, o in samples])
+    assert out == want and out
+    assert rc == want_rc == 1

@@ -288,6 +288,38 @@ def test_a_database_that_is_not_rvcs_is_never_changed(tmp_path):
         assert c.execute("PRAGMA journal_mode").fetchone() == ("delete",)
 
 
+@pytest.mark.parametrize("journal", ["delete", "wal"])
+def test_a_database_whose_tables_share_rvcs_names_is_never_changed(tmp_path, journal):
+    """Issue 36: another application's file with tables named runs, properties, verdicts, violations and
+    counters (its own columns) was switched to WAL, stamped with rvc's application_id and left with -wal/-shm
+    files, and only then refused. Whose file it is is now decided before the first write."""
+    trace = tmp_path / "t.jsonl"
+    trace.write_text('{"a":true}\n')
+    app = tmp_path / "app.db"
+    c = sqlite3.connect(app)
+    c.execute(f"PRAGMA journal_mode={journal}")
+    for table in ("runs", "properties", "verdicts", "violations", "counters"):
+        c.execute(f"CREATE TABLE {table} (run TEXT, note TEXT)")
+    c.execute("INSERT INTO runs VALUES ('mine', 'keep me')")
+    c.commit()
+    c.close()
+    assert sorted(os.listdir(tmp_path)) == ["app.db", "t.jsonl"]
+    before = sha256(app)
+    for args in (["check", "-s", "{a}", "-o", f"sqlite:{app}", str(trace)],
+                 ["monitor", "-s", "{a}", "-o", f"sqlite:{app}", "--input", f"file:{trace}"],
+                 ["dashboard", "--db", f"sqlite:{app}", "--listen", "127.0.0.1:0"]):
+        r = subprocess.run([rvc_binary(), *args], capture_output=True, text=True, timeout=60)
+        assert r.returncode == 2, (args, r.stderr)
+        assert "is not an rvc results database" in r.stderr and "refusing" in r.stderr, (args, r.stderr)
+        assert sha256(app) == before, args  # byte-identical
+        assert sorted(os.listdir(tmp_path)) == ["app.db", "t.jsonl"], args  # no -wal, -shm, spool
+    c = sqlite3.connect(app)
+    assert c.execute("PRAGMA application_id").fetchone() == (0,)
+    assert c.execute("PRAGMA journal_mode").fetchone() == (journal,)
+    assert c.execute("SELECT * FROM runs").fetchall() == [("mine", "keep me")]
+    c.close()
+
+
 def test_rvc_databases_old_and_new_are_accepted_and_the_dashboard_changes_neither(tmp_path):
     trace = tmp_path / "t.jsonl"
     trace.write_text('{"a":true}\n')
