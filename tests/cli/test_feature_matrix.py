@@ -260,3 +260,15 @@ def test_cell(rvc, data, kind, feats):
 def test_monitor_type_on_a_file_input_is_refused_in_user_terms(rvc, data):
     proc = run([rvc, "monitor", "--input", f"file:{data['single']}", "--type", "std_msgs/msg/Bool", "--spec", "{data}"])
     assert_clean_refusal(proc, "monitor_file", frozenset(), extra=["--type"])
+
+
+@pytest.mark.needs_rust
+def test_monitor_bag_refuses_a_spec_before_announcing_the_run(rvc, data):
+    """As for a file: input, a spec refused whatever the input ends `monitor --input bag:` before the
+    "rvc monitor: 1 property on ..." line, so the refusal is the first thing said."""
+    if not data["bags"]:
+        pytest.skip("rosbags is not installed (scripts/install-deps.sh)")
+    for spec in ("exists[v]. ({id: *v} and eventually[0:1]{p})", "once[0:2 {p}"):
+        proc = run([rvc, "monitor", "--input", f"bag:{data['bags']['mcap']}", "--topic", "/a", "--spec", spec])
+        assert_clean_refusal(proc, "monitor_bag", frozenset({"future"}), extra=["spec error"])
+        assert proc.stderr.startswith("rvc: spec error"), proc.stderr
