@@ -46,9 +46,9 @@ class DiscreteTimedMonitor {
     out[y_] = verdict_value(c.back(), robust_);
     return out;
   }
-  nb::dict now() const {
+  nb::dict now() const {  // the last step: -1 before the first update(), as Reelay 25 says
     nb::dict out;
-    out[t_] = nb::int_(step_ < 0 ? 0 : step_);
+    out[t_] = nb::int_(step_);
     return out;
   }
 

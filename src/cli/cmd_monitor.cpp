@@ -272,11 +272,12 @@ struct MonitorCommand {
     }
     const std::string path =
         transport::scheme_of(input) == "mcap" ? input.substr(input.find(':') + 1) : file_path(input);
+    // A bad spec (or a combination refused whatever the input) ends the run before it announces
+    // itself or writes a result, as for a file: input.
+    runtime::check_specs(properties, check.dense);
     std::fprintf(stderr, "rvc monitor: %zu propert%s on %s -> %zu output%s\n", properties.size(),
                  properties.size() == 1 ? "y" : "ies", input.c_str(), verdicts.size(), verdicts.size() == 1 ? "" : "s");
     attach_results(input, popts, verdicts);
-    if (results)  // a bad spec ends the run before any result, as without a database
-      runtime::check_specs(properties, check.dense);
     start_results({input}, properties);
     for (const auto& dir : typed.msg_paths) typed.registry.add_search_path(dir);  // what the schemas leave out
     if (check.calls && topics.size() > 1) {

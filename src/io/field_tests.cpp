@@ -27,7 +27,7 @@ const char* expected_for(const spec::FieldTest& t) {
   if (t.op == FOp::Bind) return "a string, number or Boolean to bind";
   if (t.op == FOp::Value) return "a number (or a Boolean, 1 or 0)";
   switch (t.value.kind) {
-    case spec::Literal::Kind::Bool: return "a Boolean";
+    case spec::Literal::Kind::Bool: return "a Boolean or number";
     case spec::Literal::Kind::Number: return "a number";
     case spec::Literal::Kind::String: return "a string";
   }
@@ -44,24 +44,55 @@ std::string wrong_type_problem(const spec::FieldTest& t, ValueKind kind) {
          expected_for(t);
 }
 
-int evaluate_test(const spec::FieldTest& t, const FieldValue& v) {
+namespace {
+
+// Reelay 25 reads a Boolean as the number 1 or 0 wherever a number is tested
+// ({flag > 0}, {flag == 1}): the same field then reads the same whether its
+// sender wrote it as a JSON Boolean or a ROS 2 bool/uint8.
+FieldValue as_number(const FieldValue& v) {
+  if (v.kind != ValueKind::Bool) return v;
+  FieldValue n;
+  n.kind = ValueKind::Number;
+  n.d = v.b ? 1 : 0;
+  return n;
+}
+
+// A Boolean test ({p}, {p: true}, {p: false}) reads its field as Python's
+// bool() does, as Reelay 25 does: a number is true unless 0 (NaN is true),
+// null is false. So a 0/1 flag in a uint8 field works as one. -1: a string,
+// array or object, which no Boolean test can read.
+int truth_of(const FieldValue& v) {
+  switch (v.kind) {
+    case ValueKind::Bool: return v.b;
+    case ValueKind::Number: return v.d != 0;
+    case ValueKind::Null: return 0;
+    default: return -1;
+  }
+}
+
+}  // namespace
+
+int evaluate_test(const spec::FieldTest& t, const FieldValue& field) {
   const auto lit = t.value.kind;
+  // A Boolean counts 1 or 0 against a number literal; a Boolean literal reads the field's truth.
+  FieldValue converted;
+  const FieldValue& v = lit == spec::Literal::Kind::Number && field.kind == ValueKind::Bool
+                            ? (converted = as_number(field))
+                            : field;
   const bool number = v.kind == ValueKind::Number;
   switch (t.op) {
     case FOp::Present: return 1;
     case FOp::Value: return number || v.kind == ValueKind::Bool ? 1 : -1;  // null: no value (as missing)
     case FOp::Bind:  // binds scalars; null is no value (as a missing field)
       return v.kind == ValueKind::String || v.kind == ValueKind::Number || v.kind == ValueKind::Bool ? 1 : -1;
-    case FOp::Truthy:
-      if (v.kind == ValueKind::Bool) return v.b;
-      if (number) return v.d != 0;
-      if (v.kind == ValueKind::Null) return 0;
-      return -1;
+    case FOp::Truthy: return truth_of(v);
     case FOp::Eq:
     case FOp::Ne: {
       int eq = -1;
-      if (lit == spec::Literal::Kind::Bool && v.kind == ValueKind::Bool) eq = v.b == t.value.b;
-      else if (lit == spec::Literal::Kind::Number && number) eq = compare_test(FOp::Eq, v, t.value);
+      if (lit == spec::Literal::Kind::Bool) {
+        const int truth = truth_of(v);
+        if (truth >= 0) eq = truth == static_cast<int>(t.value.b);
+      } else if (lit == spec::Literal::Kind::Number && number) eq = compare_test(FOp::Eq, v, t.value);
       else if (lit == spec::Literal::Kind::String && v.kind == ValueKind::String) eq = v.s == t.value.text;
       if (eq < 0) return -1;
       return t.op == FOp::Eq ? eq : !eq;
@@ -74,8 +105,12 @@ int evaluate_test(const spec::FieldTest& t, const FieldValue& v) {
   return -1;
 }
 
-double test_margin(const spec::FieldTest& t, const FieldValue& v) {
+double test_margin(const spec::FieldTest& t, const FieldValue& field) {
   constexpr double inf = std::numeric_limits<double>::infinity();
+  FieldValue converted;  // as evaluate_test: a Boolean against a number literal counts 1 or 0
+  const FieldValue& v = t.value.kind == spec::Literal::Kind::Number && field.kind == ValueKind::Bool
+                            ? (converted = as_number(field))
+                            : field;
   const bool number = v.kind == ValueKind::Number && t.value.kind == spec::Literal::Kind::Number;
   switch (t.op) {
     case FOp::Truthy:

@@ -93,11 +93,19 @@ struct Pastifier {
         q->variables = n.variables;
         return q;
       }
-      case Op::Pre: return node(Op::Pre, c, guard_true(visit(*n.left, d), d, c));
-      case Op::Once:
-        return bounded(Op::Once, n.bounds.lo, n.bounds.hi, c, guard_true(visit(*n.left, d), d, c));
-      case Op::Historically:
-        return bounded(Op::Historically, n.bounds.lo, n.bounds.hi, c, guard_false(visit(*n.left, d), d, c));
+      case Op::Pre: return node(Op::Pre, c, guard_pre(visit(*n.left, d), d, c));
+      // The bounds as written: an unbounded once/historically keeps its robustness start at the
+      // lowest/highest finite double (docs/semantics.md's table), where once[0:] starts at -inf.
+      case Op::Once: {
+        auto o = node(Op::Once, c, guard_true(visit(*n.left, d), d, c));
+        o->bounds = n.bounds;
+        return o;
+      }
+      case Op::Historically: {
+        auto h = node(Op::Historically, c, guard_false(visit(*n.left, d), d, c));
+        h->bounds = n.bounds;
+        return h;
+      }
       case Op::Since: {
         auto s = node(Op::Since, c, visit(*n.left, d), guard_true(visit(*n.right, d), d, c));
         s->bounds = n.bounds;
@@ -128,6 +136,14 @@ struct Pastifier {
   static NodePtr guard_true(NodePtr f, double d, int c) { return d > 0 ? both(std::move(f), started(d, c), c) : std::move(f); }
   static NodePtr guard_false(NodePtr f, double d, int c) {
     return d > 0 ? either(std::move(f), negate(started(d, c), c), c) : std::move(f);
+  }
+  // pre's operand: where its time is before the start, what pre gives at the first step (false;
+  // robustness: the lowest finite double, which `once false` is), not -inf:
+  // (f and S(d)) or (not S(d) and once false).
+  static NodePtr guard_pre(NodePtr f, double d, int c) {
+    if (d <= 0) return f;
+    auto first = both(negate(started(d, c), c), node(Op::Once, c, node(Op::False, c)), c);
+    return either(both(std::move(f), started(d, c), c), std::move(first), c);
   }
 
   // φ until[a:b] ψ at t − d: some J in [t−d+a, t−d+b] with ψ(J) and φ on

@@ -82,6 +82,58 @@ def test_discrete_robustness(rvc, tmp_path):
     assert verdicts(got) == [("p1", 0, 3, 1), ("p1", 1, 3, 2), ("p1", 2, -1, 2)]
 
 
+LOWEST = -1.7976931348623157e308  # the start of an unbounded once (highest: historically), docs/semantics.md
+
+
+def robust_value(v):
+    return float(v) if isinstance(v, str) else v  # "inf"/"-inf" on verdict lines
+
+
+def test_discrete_robustness_past_operators_beside_a_future_one_start_as_written(rvc, tmp_path):
+    """A past operator checked at a delay (beside next/eventually) starts from the value the table
+    gives it alone: unbounded once/historically from the lowest/highest finite double, pre at the
+    first step the lowest finite double; bounded windows from -inf/+inf. Oracle: the table's rules
+    evaluated in Python on random traces with fields missing at the start (margins -inf)."""
+    import random
+    inf = float("inf")
+    rng = random.Random(36)
+    for trial in range(25):
+        n = rng.randint(1, 6)
+        events = [{k: rng.randint(-3, 3) for k in ("p", "q", "x") if rng.random() < 0.5} for _ in range(n)]
+        if trial == 0:
+            events = [{"q": 1}, {"q": 1}, {"p": 1, "x": 1}]  # p and x unseen at first
+        sig = {}
+        for k in ("p", "q", "x"):
+            cur, sig[k] = -inf, []
+            for e in events:
+                cur = e.get(k, cur) if k in e else cur
+                sig[k].append(cur)
+        nxt = lambda s, t: s[t + 1] if t + 1 < n else -inf  # strong next: -inf past the end
+        def scan(op, start, f):  # unbounded once (max) / historically (min) of f(t)
+            out, acc = [], start
+            for t in range(n):
+                acc = op(acc, f(t))
+                out.append(acc)
+            return out
+        once_p = scan(max, LOWEST, lambda t: sig["p"][t])
+        hist_q = scan(min, -LOWEST, lambda t: sig["q"][t])
+        hist_not_p = scan(min, -LOWEST, lambda t: -sig["p"][t])
+        once12_p = [max([sig["p"][s] for s in range(max(0, t - 2), t)], default=-inf) for t in range(n)]
+        expected = {
+            "pre (next {x > 0})": [LOWEST if t == 0 else nxt(sig["x"], t - 1) for t in range(n)],
+            "(once {p}) or (next {p})": [max(once_p[t], nxt(sig["p"], t)) for t in range(n)],
+            "(historically {q}) and (next {q})": [min(hist_q[t], nxt(sig["q"], t)) for t in range(n)],
+            "(historically not {p}) and (next not {p})": [min(hist_not_p[t], nxt([-v for v in sig["p"]], t))
+                                                          for t in range(n)],
+            "(once[1:2] {p}) or (next {p})": [max(once12_p[t], nxt(sig["p"], t)) for t in range(n)],
+        }
+        for spec, want in expected.items():
+            got = run(rvc, tmp_path, events, [spec], "--all", "--robustness")
+            assert got.returncode in (0, 1), got.stderr
+            values = [robust_value(v) for _, _, v, _ in verdicts(got)]
+            assert values == want, f"{spec} on {events}"
+
+
 def test_past_only_lines_have_no_known_at(rvc, tmp_path):
     got = run(rvc, tmp_path, P, ["once{p}"], "--all")
     assert all("known_at" not in json.loads(l) for l in got.stdout.splitlines())

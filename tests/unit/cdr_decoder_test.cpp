@@ -85,6 +85,8 @@ const std::vector<engine::PropertySpec> kProps = {
     {"inner", "{inner.x > 0} && {inner.on} || {inner.label == \"a\"} && {inner: *}"},
     {"arrays", "{inners: *} && {fixed: *} || {bounded} || {flags == true}"},
     {"wrong", "{name > 3} || {inner.on == 1} || {u8 == \"a\"} || {inner}"},
+    // 0/1 flags in integer fields, Booleans read as numbers (Reelay's rule, io::evaluate_test)
+    {"flags01", "{u8: true} && {i8: false} || {flag > 0} && {inner.on == 1} || {c: false}"},
     {"nothing", "{inner.nothing: *} && once[0:1]{inner.nothing}"},
 };
 
@@ -146,6 +148,7 @@ TEST(CdrDecoder, RobustnessEqualsTheJsonPath) {
       {"half", "historically[0:2]({u8 >= 128} since[1:] {inners[0].x < 1}) || once[1:2]{fixed[1] != 4}"},
       {"kinds", "({flag} && {name == \"ab\"}) || {inner.on} && {short_name: *} || {bounded[1]} -> {i64 < 0}"},
       {"wrong", "{name > 3} || {inner.on == 1} || {u8 == \"a\"}"},
+      {"flags01", "({u8: true} && {i8: false}) || {flag >= 1} && {inner.on != 0} || {c: false}"},
   };
   const auto run_robust = [&](const std::vector<std::string>& jsons, const msg::MessageType* typed,
                               engine::TimeModel model, bool big_endian) {

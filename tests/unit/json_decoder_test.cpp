@@ -158,12 +158,43 @@ TEST(JsonDecoder, WrongTypeKeepsValueWithWarning) {
   EXPECT_TRUE(contains(d.warnings[0], "field \"x\" is a string")) << d.warnings[0];
   EXPECT_TRUE(contains(d.warnings[0], "{x > 2} needs a number")) << d.warnings[0];
   EXPECT_TRUE(contains(d.warnings[0], "keeps its previous value")) << d.warnings[0];
-  ASSERT_TRUE(d.feed(R"({"x": true})"));
+  ASSERT_TRUE(d.feed(R"({"x": [3]})"));
   EXPECT_EQ(d["x > 2"], 1);
   ASSERT_EQ(d.warnings.size(), 1u);
-  EXPECT_TRUE(contains(d.warnings[0], "is a Boolean")) << d.warnings[0];
+  EXPECT_TRUE(contains(d.warnings[0], "is an array")) << d.warnings[0];
   ASSERT_TRUE(d.feed(R"({"x": 1})"));
   EXPECT_EQ(d["x > 2"], 0);
+  EXPECT_TRUE(d.warnings.empty());
+}
+
+// Reelay 25's rule, measured (tests/python/test_reelay_types.py): a Boolean
+// counts 1 or 0 where a number is tested, and a Boolean test reads a number
+// as true unless 0 and null as false, so a 0/1 flag sent as a number (a ROS 2
+// uint8) reads as one sent as a Boolean.
+TEST(JsonDecoder, BooleansAndNumbersReadEachOtherAsReelayDoes) {
+  Decoder d({"{p: true}", "{p: false}", "{p}", "{p > 0}", "{p == 1}", "{p < 0.5}", "{p != 0}"});
+  struct Row { const char* value; int t, f, truthy, gt0, eq1, lt_half, ne0; };
+  const Row rows[] = {
+      {"0", 0, 1, 0, 0, 0, 1, 0},     {"1", 1, 0, 1, 1, 1, 0, 1},      {"2", 1, 0, 1, 1, 0, 0, 1},
+      {"-1", 1, 0, 1, 0, 0, 1, 1},    {"0.5", 1, 0, 1, 1, 0, 0, 1},    {"true", 1, 0, 1, 1, 1, 0, 1},
+      {"false", 0, 1, 0, 0, 0, 1, 0}, {"1", 1, 0, 1, 1, 1, 0, 1},      {"0.0", 0, 1, 0, 0, 0, 1, 0},
+  };
+  for (const Row& r : rows) {
+    ASSERT_TRUE(d.feed(std::string(R"({"p": )") + r.value + "}"));
+    EXPECT_TRUE(d.warnings.empty()) << r.value << ": " << d.warnings[0];
+    EXPECT_EQ(d["p == true"], r.t) << r.value;
+    EXPECT_EQ(d["p == false"], r.f) << r.value;
+    EXPECT_EQ(d["p"], r.truthy) << r.value;
+    EXPECT_EQ(d["p > 0"], r.gt0) << r.value;
+    EXPECT_EQ(d["p == 1"], r.eq1) << r.value;
+    EXPECT_EQ(d["p < 0.5"], r.lt_half) << r.value;
+    EXPECT_EQ(d["p != 0"], r.ne0) << r.value;
+  }
+  ASSERT_TRUE(d.feed(R"({"p": null})"));  // Boolean tests: false; comparisons: no value (kept)
+  EXPECT_EQ(d["p == true"], 0);
+  EXPECT_EQ(d["p == false"], 1);
+  EXPECT_EQ(d["p"], 0);
+  EXPECT_EQ(d["p > 0"], 0);  // kept from 0.0
   EXPECT_TRUE(d.warnings.empty());
 }
 
@@ -178,7 +209,7 @@ TEST(JsonDecoder, WrongTypeForStringBooleanAndTruthyTests) {
   EXPECT_TRUE(contains(d.warnings[0], "field \"mode\" is a number")) << d.warnings[0];
   EXPECT_TRUE(contains(d.warnings[0], "needs a string")) << d.warnings[0];
   EXPECT_TRUE(contains(d.warnings[1], "field \"p\" is a string")) << d.warnings[1];
-  EXPECT_TRUE(contains(d.warnings[1], "needs a Boolean")) << d.warnings[1];
+  EXPECT_TRUE(contains(d.warnings[1], "needs a Boolean or number")) << d.warnings[1];
   EXPECT_TRUE(contains(d.warnings[2], "field \"t\" is a string")) << d.warnings[2];
   EXPECT_TRUE(contains(d.warnings[2], "needs a Boolean or number")) << d.warnings[2];
 }
@@ -199,15 +230,15 @@ TEST(JsonDecoder, OneFieldManyTests) {
   EXPECT_EQ(d["v > 0.5"], 1);
   EXPECT_EQ(d["v: *"], 1);
   EXPECT_EQ(d["v == 0"], 0);
-  EXPECT_EQ(d["v == true"], 0);  // never set: a number is not a Boolean
-  EXPECT_EQ(d.warnings.size(), 1u);
+  EXPECT_EQ(d["v == true"], 1);  // a number other than 0 reads true (Reelay's rule)
+  EXPECT_TRUE(d.warnings.empty());
   ASSERT_TRUE(d.feed(R"({"v": false})"));
   EXPECT_EQ(d["v"], 0);
-  EXPECT_EQ(d["v > 0.5"], 1);  // wrong type: kept
+  EXPECT_EQ(d["v > 0.5"], 0);  // false counts 0
   EXPECT_EQ(d["v: *"], 1);
-  EXPECT_EQ(d["v == 0"], 0);   // kept
+  EXPECT_EQ(d["v == 0"], 1);
   EXPECT_EQ(d["v == true"], 0);
-  EXPECT_EQ(d.warnings.size(), 2u);
+  EXPECT_TRUE(d.warnings.empty());
 }
 
 TEST(JsonDecoder, PresenceAndComparisonOnOneField) {
