@@ -35,6 +35,7 @@ struct SessionOptions {
   std::string type;                    // ROS 2 type of CDR samples; empty: dict / JSON messages
   std::vector<std::string> msg_paths;  // folders of .msg / .idl definitions for `type`
   uint32_t max_data_values = 100000;
+  size_t max_message_size = 0;  // every message's cap; 0: the defaults (1 MiB JSON, 256 MiB CDR)
 };
 
 // A message rvc refused (its text names why and where); Python's ValueError.

@@ -39,7 +39,8 @@ BagRun run_bag(const std::string& path, const std::vector<std::string>& topics,
       run.has_calls = true;
       run.calls = call_feed->call_counts();
     }
-    if (run.stats.accepted == 0 && run.stats.rejected > 0) runtime::hint_bag_definition(bag);
+    // Samples only too large say nothing about the definition they were read with.
+    if (run.stats.accepted == 0 && run.stats.rejected > skipped + run.stats.oversized) runtime::hint_bag_definition(bag);
     return run;
   }
   std::vector<runtime::BagInput> bags;

@@ -27,9 +27,10 @@ void CheckOptions::add_to(CLI::App& app) {
                  "Field holding the time in dense time: a path (header.stamp) to seconds or a Time {sec, nanosec} "
                  "(typed input without it: the message's header.stamp or stamp)")
       ->capture_default_str();
-  app.add_option("--max-message-size", max_message_size, "Longest accepted message in bytes")
-      ->check(in_range(1, kMaxMessageSize, "bytes"))
-      ->capture_default_str();
+  max_message_size_option =
+      app.add_option("--max-message-size", max_message_size,
+                     "Longest accepted message in bytes (default: 1 MiB for JSON, 256 MiB for typed input: bags, --type)")
+          ->check(in_range(1, kMaxMessageSize, "bytes"));
   app.add_option("--max-errors", max_reported, "Errors and warnings printed before going quiet (all are counted)")
       ->capture_default_str();
   app.add_flag("--calls", calls,
@@ -83,6 +84,9 @@ PipelineOptions CheckOptions::pipeline_options() const {
   o.explain = explain;
   o.max_data_values = max_data_values;
   o.max_message_size = max_message_size;
+  // Given, it is the cap for every input; else typed input keeps its own
+  // (a CDR decode copies nothing it does not test: camera frames pass).
+  if (max_message_size_option && max_message_size_option->count()) o.max_typed_message_size = max_message_size;
   return o;
 }
 
