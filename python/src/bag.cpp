@@ -27,7 +27,7 @@ BagResult run(const std::string& path, const std::vector<std::pair<std::string, 
   BagResult r;
   msg::TypeRegistry registry;
   for (const auto& dir : msg_paths) registry.add_search_path(dir);
-  const runtime::BagInput bag = runtime::select_bag_topic(path, topic, registry);
+  runtime::BagInput bag = runtime::select_bag_topic(path, topic, registry);
   std::vector<engine::PropertySpec> specs;
   for (const auto& [name, spec] : properties) specs.push_back({name, spec});
   runtime::PipelineOptions po;
@@ -39,6 +39,7 @@ BagResult run(const std::string& path, const std::vector<std::pair<std::string, 
   po.type = bag.type;
   if (max_message_size) po.max_message_size = po.max_typed_message_size = max_message_size;
   po.on_report = [&](const std::string& text) { r.errors.push_back(text); };
+  runtime::set_size_cap(bag, po);
   const std::vector<std::string>* names = nullptr;
   runtime::Pipeline pipeline(specs, po, [&](const engine::Verdict& v) {
     Captured c{static_cast<uint32_t>(&v.property - names->data()), v.time, v.robust ? v.robustness > 0 : v.value,

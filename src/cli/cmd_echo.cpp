@@ -98,7 +98,9 @@ struct EchoCommand {
     for (const auto& f : fields)
       if (!select(*in.type, f, selection)) return kUsage;
     install_stop_signals();
-    auto reader = transport::open_bag(path);
+    transport::BagReadOptions read;  // the default cap; the other topics' compressed messages stay so
+    read.topics = {in.topic};
+    auto reader = transport::open_bag(path, read);
     uint64_t printed = 0, rejected = 0;
     reader->on_skip([&](const std::string& why) {
       if (++rejected <= 100) std::fprintf(stderr, "rvc: bag '%s': %s\n", path.c_str(), why.c_str());

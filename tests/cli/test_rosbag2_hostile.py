@@ -188,3 +188,81 @@ def test_corrupted_db3_never_crashes(rvc, tmp_path):
             if r.returncode not in (0, 1):
                 assert r.stderr.strip(), (k, args)
     assert 2 in seen or 3 in seen  # the damage was noticed at least once
+
+
+# --- compression bombs: per-message zstd is streamed under the size cap ------------------------------
+
+def zstd_bomb(size, declare):
+    """A zstd frame of zeros that decompresses to `size` bytes: a few tens of KB. `declare`: the frame
+    header says its size (zstd's one-shot API writes it; a streaming writer may not)."""
+    import zstandard
+    c = zstandard.ZstdCompressor(level=3, write_content_size=declare)
+    obj = c.compressobj(size=size if declare else -1)
+    block, out = bytes(16 << 20), []
+    for _ in range(size // len(block)):
+        out.append(obj.compress(block))
+    out.append(obj.flush())
+    return b"".join(out)
+
+
+def run_capped(args, mib=1024):
+    """rvc under an address-space limit: an allocation of the decompressed size fails the run."""
+    import resource
+    limit = mib << 20
+    return subprocess.run(args, capture_output=True, text=True, errors="replace", timeout=300,
+                          preexec_fn=lambda: resource.setrlimit(resource.RLIMIT_AS, (limit, limit)))
+
+
+BOMB = 1536 << 20  # 1.5 GiB of zeros, as in the issue
+
+
+def compressed_bag(folder, storage, datas):
+    """A bag folder (compression_mode: message) of /speed messages whose data are `datas` as given."""
+    folder.mkdir()
+    if storage == "sqlite3":
+        make_db3(folder / "bag_0.db3", [(1, 1000 + i, d) for i, d in enumerate(datas)])
+    else:
+        from mcap.writer import CompressionType, Writer
+        with open(folder / "bag_0.mcap", "wb") as f:
+            w = Writer(f, compression=CompressionType.NONE)
+            w.start(profile="ros2", library="rvc tests")
+            sid = w.register_schema(name="std_msgs/msg/Float64", encoding="ros2msg", data=b"float64 data")
+            ch = w.register_channel(topic="/speed", message_encoding="cdr", schema_id=sid)
+            for i, d in enumerate(datas):
+                w.add_message(channel_id=ch, log_time=1000 + i, publish_time=1000 + i, sequence=i, data=d)
+            w.finish()
+    (folder / "metadata.yaml").write_text(
+        f"rosbag2_bagfile_information:\n  version: 8\n  storage_identifier: {storage}\n"
+        f"  relative_file_paths: [bag_0.{'db3' if storage == 'sqlite3' else 'mcap'}]\n"
+        "  compression_format: zstd\n  compression_mode: message\n")
+    return str(folder)
+
+
+@pytest.mark.parametrize("storage", ["sqlite3", pytest.param("mcap", marks=pytest.mark.needs_rust)])
+@pytest.mark.parametrize("declare", [True, False])
+def test_a_zstd_bomb_message_is_rejected_and_the_next_one_checked(rvc, tmp_path, declare, storage):
+    """compression_mode: message, message 2 a 1.5 GiB zstd bomb: it was decompressed whole before the
+    size check (2.1 GB resident, std::bad_alloc exit 5 under a limit) and the valid message after it was
+    never read. Now decompression stops at the cap, under a 1 GiB address-space limit: the bomb is named
+    with its index, counted as rejected, the messages around it checked (the violation after it: exit 1)."""
+    import zstandard
+    bomb = zstd_bomb(BOMB, declare)
+    assert len(bomb) < 200_000
+    z = zstandard.ZstdCompressor()
+    folder = compressed_bag(tmp_path / "bag", storage, [z.compress(float64(1.0)), bomb, z.compress(float64(31.0)),
+                                                         z.compress(float64(2.0))])
+    def said(limit):
+        return "message 2 on /speed: zstd: " + (
+            f"its frame declares {BOMB} bytes decompressed, over the limit of {limit} (--max-message-size)" if declare
+            else f"it decompresses to more than the limit of {limit} bytes (decompression stopped there) "
+                 "(--max-message-size)")
+    for args in (["check", folder, "--spec", SPEC, "--stats"], ["monitor", "--input", f"bag:{folder}", "--spec", SPEC]):
+        r = run_capped([rvc, *args])
+        assert r.returncode == 1, (args, r.returncode, r.stderr)
+        assert said(268435456) in r.stderr, r.stderr
+        counters = json.loads(r.stderr.strip().splitlines()[-1])
+        assert (counters["received"], counters["checked"], counters["rejected"]) == (4, 3, 1), counters
+    r = run_capped([rvc, "check", folder, "--spec", SPEC, "--max-message-size", "1000"])
+    assert r.returncode == 1 and said(1000) in r.stderr, r.stderr
+    e = run_capped([rvc, "echo", folder])
+    assert e.returncode == 3 and [json.loads(x)["data"] for x in e.stdout.splitlines()] == [1.0, 31.0, 2.0], e.stderr

@@ -72,13 +72,14 @@ void merge_topic(std::map<std::string, BagTopicInfo>& into, const BagTopicInfo& 
 // a message whose data is a zstd frame is given decompressed.
 class DecompressingBag : public BagReader {
  public:
-  explicit DecompressingBag(std::unique_ptr<BagReader> inner) : BagReader(inner->path()), inner_(std::move(inner)) {}
+  DecompressingBag(std::unique_ptr<BagReader> inner, const BagReadOptions& options)
+      : BagReader(inner->path()), inner_(std::move(inner)), options_(options) {}
   bool next(BagMessage& m) override {
     inner_->on_skip(on_skip_);
     while (inner_->next(m)) {
-      if (!is_zstd_frame(m.data)) return true;
+      if (!is_zstd_frame(m.data) || !wanted(m.topic)) return true;
       std::string error;
-      if (zstd_decompress(m.data, buffer_, error)) {
+      if (zstd_decompress(m.data, buffer_, error, options_.max_message_size)) {
         m.data = buffer_;
         return true;
       }
@@ -88,7 +89,12 @@ class DecompressingBag : public BagReader {
   }
 
  private:
+  bool wanted(std::string_view topic) const {
+    return options_.topics.empty() ||
+           std::find(options_.topics.begin(), options_.topics.end(), topic) != options_.topics.end();
+  }
   std::unique_ptr<BagReader> inner_;
+  BagReadOptions options_;
   std::string buffer_;
 };
 
@@ -180,7 +186,7 @@ std::unique_ptr<BagReader> open_storage_file(const std::string& path, const std:
 }
 
 // One storage file, decompressed first if rosbag2 compressed it whole.
-std::unique_ptr<BagReader> open_file(const std::string& path) {
+std::unique_ptr<BagReader> open_file(const std::string& path, const BagReadOptions& options) {
   std::ifstream probe(path, std::ios::binary);
   if (!probe) throw BagError("bag '" + path + "': cannot open it (" + std::strerror(errno) + ")");
   if (is_zstd_frame(head_of(path, 4))) {
@@ -188,7 +194,7 @@ std::unique_ptr<BagReader> open_file(const std::string& path) {
     auto inner = open_storage_file(copy->path(), path);
     return std::make_unique<CopiedBag>(path, std::move(copy), std::move(inner));
   }
-  return std::make_unique<DecompressingBag>(open_storage_file(path, path));
+  return std::make_unique<DecompressingBag>(open_storage_file(path, path), options);
 }
 
 
@@ -267,14 +273,14 @@ std::string binary_signature(const std::string& path) {
   return "";
 }
 
-std::unique_ptr<BagReader> open_bag(const std::string& path) {
-  if (!is_dir(path)) return open_file(path);
+std::unique_ptr<BagReader> open_bag(const std::string& path, const BagReadOptions& options) {
+  if (!is_dir(path)) return open_file(path, options);
   if (!std::filesystem::exists(std::filesystem::path(path) / "metadata.yaml"))
     throw BagError("'" + path + "' is a folder without metadata.yaml: not a rosbag2 bag folder (give a .mcap or .db3 "
                    "file of it instead)");
   const BagMetadata md = read_bag_metadata(path);
   std::vector<std::unique_ptr<BagReader>> parts;
-  for (const auto& f : md.files) parts.push_back(open_file(f));
+  for (const auto& f : md.files) parts.push_back(open_file(f, options));
   if (parts.size() == 1) return std::move(parts[0]);
   return std::make_unique<MergedBag>(path, std::move(parts));
 }

@@ -26,8 +26,23 @@ struct DStream {
 };
 }  // namespace
 
-bool zstd_decompress(std::string_view in, std::string& out, std::string& error) {
+bool zstd_decompress(std::string_view in, std::string& out, std::string& error, size_t max_out, bool* too_large) {
   out.clear();
+  if (too_large) *too_large = false;
+  auto over = [&](const std::string& what) {
+    out.clear();
+    out.shrink_to_fit();  // a bomb's partial output is not kept for the next message
+    if (too_large) *too_large = true;
+    error = "zstd: " + what + " (--max-message-size)";
+    return false;
+  };
+  // A frame that says its size up front is refused before any byte is made.
+  const unsigned long long declared = ZSTD_getFrameContentSize(in.data(), in.size());
+  if (declared != ZSTD_CONTENTSIZE_UNKNOWN && declared != ZSTD_CONTENTSIZE_ERROR) {
+    if (declared > max_out) return over("its frame declares " + std::to_string(declared) + " bytes decompressed, over the limit of " +
+                                            std::to_string(max_out));
+    out.reserve(static_cast<size_t>(declared));
+  }
   DStream d;
   ZSTD_inBuffer src{in.data(), in.size(), 0};
   std::vector<char> buf(ZSTD_DStreamOutSize());
@@ -39,6 +54,9 @@ bool zstd_decompress(std::string_view in, std::string& out, std::string& error) 
       error = std::string("zstd: ") + ZSTD_getErrorName(ret) + " near byte " + std::to_string(src.pos);
       return false;
     }
+    if (dst.pos > max_out - out.size())  // streamed: memory stops at the cap, whatever the frame claims
+      return over("it decompresses to more than the limit of " + std::to_string(max_out) +
+                  " bytes (decompression stopped there)");
     out.append(buf.data(), dst.pos);
     if (src.pos == src.size && dst.pos < dst.size) break;  // all input read, nothing more held back
   }
