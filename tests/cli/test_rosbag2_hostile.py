@@ -266,3 +266,94 @@ def test_a_zstd_bomb_message_is_rejected_and_the_next_one_checked(rvc, tmp_path,
     assert r.returncode == 1 and said(1000) in r.stderr, r.stderr
     e = run_capped([rvc, "echo", folder])
     assert e.returncode == 3 and [json.loads(x)["data"] for x in e.stdout.splitlines()] == [1.0, 31.0, 2.0], e.stderr
+
+
+# --- a damaged page: everything readable is read, the damage named and counted ----------------------
+
+N_DAMAGED = 2130
+
+
+def damaged_bag(tmp_path, where, index=False, values=None):
+    """A bag of N_DAMAGED Float64 messages (data = i % 20, or `values`), one leaf page of table
+    'messages' overwritten with 0xff: the middle one, or the last. SQLite's dbstat names the pages."""
+    values = values or [float(i % 20) for i in range(N_DAMAGED)]
+    bag = make_db3(tmp_path / "good.db3", good_rows(values))
+    con = sqlite3.connect(bag)
+    if index:  # rosbag2's own schema has it: ORDER BY timestamp then streams through the index
+        con.execute("CREATE INDEX timestamp_idx ON messages (timestamp ASC)")
+        con.commit()
+    leaves = [p for (p,) in con.execute("SELECT pageno FROM dbstat WHERE name = 'messages' AND pagetype = 'leaf' "
+                                        "ORDER BY pageno")]
+    page_size = con.execute("PRAGMA page_size").fetchone()[0]
+    con.close()
+    page = leaves[len(leaves) // 2] if where == "middle" else leaves[-1]
+    data = bytearray(open(bag, "rb").read())
+    data[(page - 1) * page_size: page * page_size] = b"\xff" * page_size
+    bad = tmp_path / f"damaged_{where}.db3"
+    bad.write_bytes(bytes(data))
+    return str(bad), values
+
+
+def sqlite_oracle(path):
+    """Python's sqlite3 on the damaged file: the rows a scan returns before the error, and the rows
+    a lookup by row id reads (every row not on the bad page)."""
+    con = sqlite3.connect(f"file:{path}?immutable=1", uri=True)
+    scanned = 0
+    with pytest.raises(sqlite3.DatabaseError, match="malformed"):
+        for _ in con.execute("SELECT id, topic_id, timestamp, data FROM messages"):
+            scanned += 1
+    readable = []
+    for i in range(1, N_DAMAGED + 1):
+        try:
+            if con.execute("SELECT id FROM messages WHERE id = ?", (i,)).fetchone():
+                readable.append(i)
+        except sqlite3.DatabaseError:
+            pass
+    con.close()
+    return scanned, readable
+
+
+@pytest.mark.parametrize("index", [False, True])
+def test_a_damaged_page_costs_only_its_rows(rvc, tmp_path, index):
+    """One damaged leaf page in the middle of table 'messages': the bag was refused whole ("database
+    disk image is malformed", exit 2, nothing checked; `bag info` 0 messages). Now every row SQLite can
+    read is checked (the oracle: Python's sqlite3, by row id), the lost row ids are named once and
+    counted as one rejected record (received = checked + rejected), the violation after the damage is
+    found (exit 1), a property that holds exits 3; `bag info` counts the readable rows and says why."""
+    values = [1.0] * N_DAMAGED
+    values[-5] = 31.0  # after the damaged page: found only if reading goes on past it
+    bag, values = damaged_bag(tmp_path, "middle", index, values)
+    scanned, readable = sqlite_oracle(bag)
+    lost = [i for i in range(1, N_DAMAGED + 1) if i not in set(readable)]
+    assert 0 < scanned < len(readable) < N_DAMAGED and lost == list(range(lost[0], lost[-1] + 1))
+    r = check(rvc, bag)
+    assert r.returncode == 1, r.stderr
+    assert f"row ids {lost[0]}-{lost[-1]} of table 'messages' cannot be read (SQLite: database disk image is " \
+           f"malformed), after message {lost[0] - 1}: skipped; reading goes on at row id {lost[-1] + 1}" in r.stderr
+    counters = json.loads(r.stderr.strip().splitlines()[-1])
+    assert (counters["received"], counters["checked"], counters["rejected"]) == (len(readable) + 1, len(readable), 1)
+    ok = run([rvc, "check", bag, "--spec", "historically({data < 100})", "--stats"])
+    assert ok.returncode == 3, ok.stderr
+    e = run([rvc, "echo", bag])
+    assert e.returncode == 3, e.stderr
+    assert [json.loads(x)["data"] for x in e.stdout.splitlines()] == [values[i - 1] for i in readable]
+    info = run([rvc, "bag", "info", bag, "--json"])
+    assert info.returncode == 3, info.stderr
+    s = json.loads(info.stdout)
+    assert s["messages"] == len(readable) and f"row ids {lost[0]}-{lost[-1]}" in s["skipped"], s
+
+
+def test_a_damaged_last_page_keeps_the_rows_before_it(rvc, tmp_path):
+    """The last leaf damaged: every row before it is checked (as many as SQLite reads by row id; a
+    scan gives one fewer), then the rest is named as unreadable: exit 3, `bag info` the same counts."""
+    bag, values = damaged_bag(tmp_path, "last")
+    scanned, readable = sqlite_oracle(bag)
+    assert readable == list(range(1, len(readable) + 1)) and scanned <= len(readable) < N_DAMAGED
+    r = check(rvc, bag)
+    assert r.returncode == 3, r.stderr
+    assert f"SQLite cannot read on after message {len(readable)}: the rows from row id {len(readable) + 1} on of " \
+           "table 'messages' cannot be read (database disk image is malformed)" in r.stderr, r.stderr
+    counters = json.loads(r.stderr.strip().splitlines()[-1])
+    assert (counters["received"], counters["checked"]) == (len(readable), len(readable))
+    info = run([rvc, "bag", "info", bag, "--json"])
+    assert info.returncode == 3 and json.loads(info.stdout)["messages"] == len(readable), info.stderr

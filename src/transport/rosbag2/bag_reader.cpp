@@ -216,6 +216,7 @@ void summarize_file(const std::string& path, BagSummary& s, std::map<std::string
       SqliteBag(file).summarize(one);
       if (s.storage.empty()) s.storage = "sqlite3";
       if (s.broken.empty() && !one.broken.empty()) s.broken = one.broken;
+      if (s.first_skipped.empty() && !one.first_skipped.empty()) s.first_skipped = one.first_skipped;
       for (const auto& t : one.topics) merge_topic(topics, t);
       return;
     }
