@@ -357,3 +357,44 @@ def test_a_damaged_last_page_keeps_the_rows_before_it(rvc, tmp_path):
     assert (counters["received"], counters["checked"]) == (len(readable), len(readable))
     info = run([rvc, "bag", "info", bag, "--json"])
     assert info.returncode == 3 and json.loads(info.stdout)["messages"] == len(readable), info.stderr
+
+
+# --- bag folders whose entries are no files -----------------------------------------------------------
+
+@pytest.mark.parametrize("case", ["metadata loop", "metadata folder", "storage loop", "storage folder",
+                                  "storage dangling"])
+def test_a_bag_folder_entry_that_is_no_file_is_named(rvc, tmp_path, case):
+    """metadata.yaml or a storage file that is a symlink loop, a folder or a dangling link ended
+    check/echo/bag info with an uncaught C++ exception ("rvc: error: filesystem error: ...",
+    "basic_filebuf::underflow error ..."), exit 5. Now: one line naming the path and the problem, exit 2."""
+    folder = tmp_path / "bag"
+    folder.mkdir()
+    make_db3(folder / "bag_0.db3", good_rows([1.0]))
+    md = "rosbag2_bagfile_information:\n  relative_file_paths: [{}]\n"
+    if case.startswith("metadata"):
+        target, why = folder / "metadata.yaml", ("Too many levels of symbolic links" if "loop" in case
+                                                  else "it is a folder, not a file")
+        if "loop" in case:
+            os.symlink("metadata.yaml", target)
+        else:
+            target.mkdir()
+        needle = f"cannot read {target}: {why}"
+    else:
+        (folder / "metadata.yaml").write_text(md.format("x.db3"))
+        target = folder / "x.db3"
+        if "loop" in case:
+            os.symlink("y.db3", target)
+            os.symlink("x.db3", folder / "y.db3")
+            why = "Too many levels of symbolic links"
+        elif "folder" in case:
+            target.mkdir()
+            why = "it is a folder, not a file"
+        else:
+            os.symlink("gone.db3", target)
+            why = "No such file or directory"
+        needle = f"metadata.yaml lists 'x.db3', which cannot be read: {target}: {why}"
+    for args in (["check", str(folder), "--spec", SPEC], ["echo", str(folder)], ["bag", "info", str(folder)],
+                 ["monitor", "--input", f"bag:{folder}", "--spec", SPEC]):
+        r = run([rvc, *args])
+        assert r.returncode == 2, (case, args, r.returncode, r.stderr)
+        assert needle in r.stderr and "error:" not in r.stderr, (case, args, r.stderr)

@@ -240,7 +240,7 @@ const BagTopicInfo* BagSummary::topic(std::string_view name) const {
 
 BagKind bag_kind(const std::string& path) {
   if (is_dir(path))
-    return std::filesystem::exists(std::filesystem::path(path) / "metadata.yaml") ? BagKind::Folder : BagKind::None;
+    return names_entry((std::filesystem::path(path) / "metadata.yaml").string()) ? BagKind::Folder : BagKind::None;
   const std::string head = head_of(path, 16);
   if (is_zstd_frame(head)) {  // rosbag2's per-file compression: name says what is inside
     const std::string name = std::filesystem::path(path).filename().string();
@@ -276,7 +276,7 @@ std::string binary_signature(const std::string& path) {
 
 std::unique_ptr<BagReader> open_bag(const std::string& path, const BagReadOptions& options) {
   if (!is_dir(path)) return open_file(path, options);
-  if (!std::filesystem::exists(std::filesystem::path(path) / "metadata.yaml"))
+  if (!names_entry((std::filesystem::path(path) / "metadata.yaml").string()))
     throw BagError("'" + path + "' is a folder without metadata.yaml: not a rosbag2 bag folder (give a .mcap or .db3 "
                    "file of it instead)");
   const BagMetadata md = read_bag_metadata(path);
@@ -291,7 +291,7 @@ BagSummary summarize_bag(const std::string& path) {
   s.path = path;
   std::map<std::string, BagTopicInfo> topics;
   if (is_dir(path)) {
-    if (!std::filesystem::exists(std::filesystem::path(path) / "metadata.yaml")) open_bag(path);  // throws
+    if (!names_entry((std::filesystem::path(path) / "metadata.yaml").string())) open_bag(path);  // throws
     const BagMetadata md = read_bag_metadata(path);
     s.compression_format = md.compression_format;
     s.compression_mode = md.compression_mode;
