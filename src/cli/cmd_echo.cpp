@@ -145,6 +145,12 @@ struct EchoCommand {
 
   int run() {
     if (const std::string bag = bag_path(); !bag.empty()) return run_bag(bag);
+    if (transport::scheme_of(input) == "file" && input != "-")
+      if (const std::string path = input.rfind("file:", 0) == 0 ? input.substr(5) : input;
+          !transport::truncated_bag(path).empty()) {
+        std::fprintf(stderr, "rvc: bag '%s' is %s\n", path.c_str(), transport::truncated_bag(path).c_str());
+        return kUsage;
+      }
     if (!topic.empty()) {
       std::fprintf(stderr, "rvc: --topic chooses a topic of a bag (bag:PATH, a .mcap or .db3 file, a bag folder)\n");
       return kUsage;

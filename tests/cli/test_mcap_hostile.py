@@ -415,3 +415,21 @@ def test_a_record_with_a_bad_length_keeps_the_records_before_it(mcap_rvc, tmp_pa
     assert (counters["received"], counters["checked"], counters["rejected"]) == (len(want) + 1, len(want), 1)
     same = run([mcap_rvc, "check", "--all", "--spec", "{p}", json_trace(tmp_path, want)])
     assert c.stdout == same.stdout
+
+
+@pytest.mark.parametrize("name,content,said", [
+    ("rec.mcap", b"", "is an empty file (0 bytes), not an MCAP file: a recording cut short before its first byte?"),
+    ("rec.mcap", MAGIC[:5], "is a truncated MCAP file: 5 bytes, its 8-byte magic cut short"),
+    ("rec.db3", b"", "is an empty file (0 bytes), not a rosbag2 sqlite3 file"),
+])
+def test_an_empty_or_cut_bag_file_is_named_so(mcap_rvc, tmp_path, name, content, said):
+    """An empty .mcap with --topic was "a JSON-lines trace" (and without --topic "nothing was
+    checked", exit 6): now every command says it is an empty or truncated bag file, exit 2."""
+    bag = tmp_path / name
+    bag.write_bytes(content)
+    for args in (["check", str(bag), "--topic", "/x", "--spec", "{p}"], ["check", str(bag), "--spec", "{p}"],
+                 ["echo", str(bag), "--topic", "/x"], ["bag", "info", str(bag)],
+                 ["monitor", "--input", f"bag:{bag}", "--spec", "{p}"]):
+        r = run([mcap_rvc, *args])
+        assert r.returncode == 2, (args, r.stderr)
+        assert f"bag '{bag}' {said}" in r.stderr and "JSON-lines" not in r.stderr, (args, r.stderr)

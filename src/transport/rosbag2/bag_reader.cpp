@@ -180,6 +180,7 @@ std::unique_ptr<BagReader> open_storage_file(const std::string& path, const std:
 #endif
     default: break;
   }
+  if (const std::string cut = truncated_bag(shown); !cut.empty()) throw BagError("bag '" + shown + "' is " + cut);
   const std::string what = binary_signature(shown);
   throw BagError("'" + shown + "' is not a ROS 2 bag (MCAP, rosbag2 sqlite3 or a bag folder)" +
                  (what.empty() ? std::string() : ": it is " + what));
@@ -253,6 +254,31 @@ BagKind bag_kind(const std::string& path) {
     return BagKind::None;
   }
   return file_kind(head);
+}
+
+std::string truncated_bag(const std::string& path) {
+  const std::string name = std::filesystem::path(path).filename().string();
+  auto ends = [&](const char* suffix) {
+    const size_t n = std::strlen(suffix);
+    return name.size() > n && name.compare(name.size() - n, n, suffix) == 0;
+  };
+  const bool zstd = ends(".zstd");
+  const char* magic = nullptr;
+  size_t magic_len = 0;
+  std::string kind;
+  if (ends(".mcap") || ends(".mcap.zstd")) magic = kMcapMagic, magic_len = 8, kind = "an MCAP file";
+  else if (ends(".db3") || ends(".db3.zstd")) magic = kSqliteMagic, magic_len = 16, kind = "a rosbag2 sqlite3 file";
+  else return "";
+  struct stat st{};
+  if (::stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) return "";
+  if (st.st_size == 0) return "an empty file (0 bytes), not " + kind + (zstd ? " compressed with zstd" : "") +
+                              ": a recording cut short before its first byte?";
+  if (zstd) return "";  // what a frame holds is told when it is decompressed
+  const std::string head = head_of(path, magic_len);
+  if (head.size() < magic_len && std::memcmp(head.data(), magic, head.size()) == 0)
+    return "a truncated " + kind.substr(kind.find(' ') + 1) + ": " + std::to_string(head.size()) +
+           " bytes, its " + std::to_string(magic_len) + "-byte magic cut short (a recording cut short?)";
+  return "";
 }
 
 std::string binary_signature(const std::string& path) {

@@ -101,6 +101,13 @@ struct BagReadOptions {
   std::vector<std::string> topics;
 };
 
+// For a regular file whose name says it is a bag (.mcap, .db3, with or
+// without .zstd) but whose bytes are not one because they stop short of the
+// storage's magic (an empty file, a recording cut short at its start): what
+// it is, e.g. "an empty file (0 bytes), not an MCAP file: a recording cut
+// short?". "" otherwise.
+std::string truncated_bag(const std::string& path);
+
 // Opens a bag (throws BagError for what is no bag, naming what it is).
 std::unique_ptr<BagReader> open_bag(const std::string& path, const BagReadOptions& options = {});
 
