@@ -1,5 +1,6 @@
 #include "transport/rosbag2/zstd_bag.hpp"
 
+#include <sys/statvfs.h>
 #include <unistd.h>
 #include <zstd.h>
 
@@ -78,7 +79,7 @@ ZstdFileCopy::ZstdFileCopy(const std::string& compressed) {
   std::unique_ptr<FILE, int (*)(FILE*)> out(::fdopen(fd, "wb"), &std::fclose);
   DStream d;
   std::vector<char> ibuf(ZSTD_DStreamInSize()), obuf(ZSTD_DStreamOutSize());
-  uint64_t offset = 0;
+  uint64_t offset = 0, written = 0, checked_at = 0;
   size_t ret = 0;
   auto fail = [&](const std::string& why) {
     ::unlink(path_.c_str());
@@ -95,6 +96,18 @@ ZstdFileCopy::ZstdFileCopy(const std::string& compressed) {
              std::to_string(offset + src.pos));
       if (dst.pos && std::fwrite(obuf.data(), 1, dst.pos, out.get()) != dst.pos)
         fail("cannot write the decompressed copy to " + path_);
+      written += dst.pos;
+      // A frame of a few KB may expand to any size (RLE blocks): the copy
+      // stops before it fills the disk, leaving 5% of it to everyone else.
+      if (written - checked_at >= (uint64_t{64} << 20)) {
+        checked_at = written;
+        struct statvfs fs{};
+        if (::fstatvfs(fd, &fs) == 0 &&
+            static_cast<uint64_t>(fs.f_bavail) * fs.f_frsize < static_cast<uint64_t>(fs.f_blocks) * fs.f_frsize / 20)
+          fail("its decompressed copy reached " + std::to_string(written) + " bytes in " + path_ +
+               " and would leave less than 5% of that file system free: stopped there (set TMPDIR to a folder "
+               "with more room)");
+      }
       if (src.pos == src.size && dst.pos < dst.size) break;
     }
     offset += src.size;
