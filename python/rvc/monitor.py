@@ -59,6 +59,15 @@ def to_dataframe(verdicts: Iterable[Verdict]):
     return pd.DataFrame([[getattr(v, c) for c in cols] for v in verdicts], columns=cols)
 
 
+def _max_message_size(n: Optional[int]) -> int:
+    """--max-message-size's rule: 1 byte to 1 GiB; None: the defaults (0 to the extension)."""
+    if n is None:
+        return 0
+    if isinstance(n, bool) or not isinstance(n, int) or not 1 <= n <= 1 << 30:
+        raise ValueError(f"max_message_size must be a whole number of bytes from 1 to {1 << 30} (1 GiB), not {n!r}")
+    return n
+
+
 class Monitor:
     """Properties checked together over one stream of messages.
 
@@ -73,14 +82,18 @@ class Monitor:
     verdict says why. all: a verdict at every step (discrete), not only changes.
     type: messages are CDR samples of this ROS 2 type (update_cdr), decoded by rvc's type
     registry (bundled common_interfaces, or msg_path folders of .msg / .idl files).
+    max_message_size: the longest message accepted, in bytes (default 1 MiB for dicts / JSON, 256 MiB
+    for CDR samples; at most 1 GiB), as `--max-message-size`.
     """
 
     def __init__(self, properties: Properties, *, dense: bool = False, robustness: bool = False,
                  explain: bool = False, all: bool = False, time_field: str = "time", type: Optional[str] = None,
-                 msg_path: Sequence[str] = (), max_data_values: int = 100000, origin: str = "first"):
+                 msg_path: Sequence[str] = (), max_data_values: int = 100000,
+                 max_message_size: Optional[int] = None, origin: str = "first"):
         self._args = dict(properties=_properties(properties), dense=dense, robustness=robustness, explain=explain,
                           emit_all=all, time_field=time_field, msg_paths=[os.fspath(p) for p in msg_path],
-                          max_data_values=max_data_values, origin=origin)
+                          max_data_values=max_data_values, max_message_size=_max_message_size(max_message_size),
+                          origin=origin)
         self._type = type
         self._session = _rvc.Session(type=type or "", **self._args)
         self._fed = False
@@ -167,12 +180,13 @@ class BagResult:
 
 def check_bag(path, properties: Properties, *, topic: Optional[str] = None, dense: bool = False,
               robustness: bool = False, explain: bool = False, all: bool = False,
-              msg_path: Sequence[str] = ()) -> BagResult:
+              msg_path: Sequence[str] = (), max_message_size: Optional[int] = None) -> BagResult:
     """Checks one topic of a ROS 2 bag (MCAP, a .db3 file or a bag folder; MCAP needs a package
     built with it: rvc.has_mcap) as `rvc check BAG --topic TOPIC` does: the types from the bag's schemas,
-    messages in the bag's order. topic may be left out when the bag has one topic."""
+    messages in the bag's order. topic may be left out when the bag has one topic. max_message_size: as
+    `--max-message-size` (default 256 MiB for CDR messages, 1 MiB for JSON ones)."""
     r = _rvc.check_bag(os.fspath(path), _properties(properties), topic or "", dense, robustness, explain, all,
-                       [os.fspath(p) for p in msg_path])
+                       [os.fspath(p) for p in msg_path], _max_message_size(max_message_size))
     names = r.pop("names")
     r["verdicts"] = _verdicts(names, r["verdicts"])
     return BagResult(names=names, **r)

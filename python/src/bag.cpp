@@ -23,11 +23,11 @@ struct BagResult {
 
 BagResult run(const std::string& path, const std::vector<std::pair<std::string, std::string>>& properties,
               const std::string& topic, bool dense, bool robustness, bool explain, bool emit_all,
-              const std::vector<std::string>& msg_paths) {
+              const std::vector<std::string>& msg_paths, size_t max_message_size) {
   BagResult r;
   msg::TypeRegistry registry;
   for (const auto& dir : msg_paths) registry.add_search_path(dir);
-  const runtime::BagInput bag = runtime::select_bag_topic(path, topic, registry);
+  runtime::BagInput bag = runtime::select_bag_topic(path, topic, registry);
   std::vector<engine::PropertySpec> specs;
   for (const auto& [name, spec] : properties) specs.push_back({name, spec});
   runtime::PipelineOptions po;
@@ -37,7 +37,9 @@ BagResult run(const std::string& path, const std::vector<std::pair<std::string, 
   po.explain = explain;
   po.position_name = "message";
   po.type = bag.type;
+  if (max_message_size) po.max_message_size = po.max_typed_message_size = max_message_size;
   po.on_report = [&](const std::string& text) { r.errors.push_back(text); };
+  runtime::set_size_cap(bag, po);
   const std::vector<std::string>* names = nullptr;
   runtime::Pipeline pipeline(specs, po, [&](const engine::Verdict& v) {
     Captured c{static_cast<uint32_t>(&v.property - names->data()), v.time, v.robust ? v.robustness > 0 : v.value,
@@ -69,11 +71,11 @@ void bind_bag(nb::module_& m) {
       "check_bag",
       [](const std::string& path, const std::vector<std::pair<std::string, std::string>>& properties,
          const std::string& topic, bool dense, bool robustness, bool explain, bool emit_all,
-         const std::vector<std::string>& msg_paths) {
+         const std::vector<std::string>& msg_paths, size_t max_message_size) {
         BagResult r;
         {
           nb::gil_scoped_release unlocked;  // a long bag does not hold up other Python threads
-          r = run(path, properties, topic, dense, robustness, explain, emit_all, msg_paths);
+          r = run(path, properties, topic, dense, robustness, explain, emit_all, msg_paths, max_message_size);
         }
         nb::list verdicts;
         for (const Captured& c : r.verdicts) {
@@ -99,7 +101,7 @@ void bind_bag(nb::module_& m) {
         return d;
       },
       nb::arg("path"), nb::arg("properties"), nb::arg("topic"), nb::arg("dense"), nb::arg("robustness"),
-      nb::arg("explain"), nb::arg("emit_all"), nb::arg("msg_paths"));
+      nb::arg("explain"), nb::arg("emit_all"), nb::arg("msg_paths"), nb::arg("max_message_size") = 0);
 }
 
 }  // namespace rvc::python

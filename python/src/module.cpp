@@ -89,7 +89,8 @@ void bind_session(nb::module_& m) {
       .def("__init__",
            [](Session* self, const std::vector<std::pair<std::string, std::string>>& properties, bool dense,
               bool robustness, bool explain, bool emit_all, const std::string& time_field, const std::string& type,
-              const std::vector<std::string>& msg_paths, uint32_t max_data_values, const std::string& origin) {
+              const std::vector<std::string>& msg_paths, uint32_t max_data_values, size_t max_message_size,
+              const std::string& origin) {
              std::vector<engine::PropertySpec> specs;
              for (const auto& [name, spec] : properties) specs.push_back({name, spec});
              SessionOptions o;
@@ -101,13 +102,15 @@ void bind_session(nb::module_& m) {
              o.type = type;
              o.msg_paths = msg_paths;
              o.max_data_values = max_data_values;
+             o.max_message_size = max_message_size;
              if (origin != "first" && origin != "zero")
                throw nb::value_error(("origin must be 'first' or 'zero', not '" + origin + "'").c_str());
              o.origin_zero = origin == "zero";
              new (self) Session(std::move(specs), std::move(o));
            },
            nb::arg("properties"), nb::arg("dense"), nb::arg("robustness"), nb::arg("explain"), nb::arg("emit_all"),
-           nb::arg("time_field"), nb::arg("type"), nb::arg("msg_paths"), nb::arg("max_data_values"), nb::arg("origin") = "first")
+           nb::arg("time_field"), nb::arg("type"), nb::arg("msg_paths"), nb::arg("max_data_values"),
+           nb::arg("max_message_size") = 0, nb::arg("origin") = "first")
       .def("update",
            [](Session& s, nb::handle message) {
              std::string line;

@@ -15,6 +15,7 @@ Session::Session(std::vector<engine::PropertySpec> properties, SessionOptions op
   po.explain = options_.explain;
   po.max_data_values = options_.max_data_values;
   po.origin = options_.origin_zero ? runtime::Origin::Zero : runtime::Origin::First;
+  if (options_.max_message_size) po.max_message_size = po.max_typed_message_size = options_.max_message_size;
   po.on_report = [this](const std::string& text) { on_report(text); };
   if (!options_.type.empty()) {
     for (const auto& dir : options_.msg_paths) registry_.add_search_path(dir);

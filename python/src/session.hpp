@@ -38,6 +38,7 @@ struct SessionOptions {
   // Dense time: where the timeline starts (runtime/engine_time.hpp). Reelay's
   // drop-in API keeps Reelay's 0; rvc.Monitor starts at the first message.
   bool origin_zero = false;
+  size_t max_message_size = 0;  // every message's cap; 0: the defaults (1 MiB JSON, 256 MiB CDR)
 };
 
 // A message rvc refused (its text names why and where); Python's ValueError.

@@ -16,7 +16,8 @@ BagRun run_bag(const std::string& path, const std::vector<std::string>& topics,
   options.position_name = "message";
   auto on_verdict = [&](const engine::Verdict& v) { outputs.put(v); };
   if (topics.size() <= 1 && (topics.empty() || topics[0].find('=') == std::string::npos || topics[0][0] == '/')) {
-    const runtime::BagInput bag = runtime::select_bag_topic(path, topics.empty() ? "" : topics[0], registry);
+    runtime::BagInput bag = runtime::select_bag_topic(path, topics.empty() ? "" : topics[0], registry);
+    runtime::set_size_cap(bag, options);
     const bool calls = calls_timeout > 0;
     options.type = calls ? nullptr : bag.type;  // --calls: the properties read the calls, JSON
     runtime::Pipeline pipeline(properties, options, on_verdict);
@@ -39,12 +40,14 @@ BagRun run_bag(const std::string& path, const std::vector<std::string>& topics,
       run.has_calls = true;
       run.calls = call_feed->call_counts();
     }
-    if (run.stats.accepted == 0 && run.stats.rejected > 0) runtime::hint_bag_definition(bag);
+    // Samples only too large say nothing about the definition they were read with.
+    if (run.stats.accepted == 0 && run.stats.rejected > skipped + run.stats.oversized) runtime::hint_bag_definition(bag);
     return run;
   }
   std::vector<runtime::BagInput> bags;
   std::vector<runtime::SyncInput> inputs = runtime::select_bag_topics(path, topics, registry, bags);
   sync.apply_stamps(inputs);
+  for (auto& b : bags) runtime::set_size_cap(b, options);
   runtime::SyncedPipeline pipeline(properties, options, inputs, sync.options(inputs), on_verdict);
   for (size_t i = 0; i < bags.size(); ++i) {
     run.messages += bags[i].messages;

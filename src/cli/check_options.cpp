@@ -35,9 +35,10 @@ void CheckOptions::add_to(CLI::App& app) {
                  "(typed input without it: the message's header.stamp or stamp)")
       ->check(field_name())
       ->capture_default_str();
-  app.add_option("--max-message-size", max_message_size, "Longest accepted message in bytes")
-      ->check(in_range(1, kMaxMessageSize, "bytes"))
-      ->capture_default_str();
+  max_message_size_option =
+      app.add_option("--max-message-size", max_message_size,
+                     "Longest accepted message in bytes (default: 1 MiB for JSON, 256 MiB for typed input: bags, --type)")
+          ->check(in_range(1, kMaxMessageSize, "bytes"));
   app.add_option("--max-errors", max_reported, "Errors and warnings printed before going quiet (all are counted)")
       ->check(in_range(0, 1e9))
       ->capture_default_str();
@@ -93,6 +94,9 @@ PipelineOptions CheckOptions::pipeline_options() const {
   o.max_data_values = max_data_values;
   o.max_message_size = max_message_size;
   o.origin = origin == "zero" ? runtime::Origin::Zero : runtime::Origin::First;
+  // Given, it is the cap for every input; else typed input keeps its own
+  // (a CDR decode copies nothing it does not test: camera frames pass).
+  if (max_message_size_option && max_message_size_option->count()) o.max_typed_message_size = max_message_size;
   return o;
 }
 

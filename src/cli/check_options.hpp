@@ -21,7 +21,8 @@ struct CheckOptions {
   bool all = false;
   bool strict = false;
   std::string time_field = "time";
-  size_t max_message_size = 1 << 20;
+  size_t max_message_size = 1 << 20;  // JSON; typed input: PipelineOptions' own default unless given
+  CLI::Option* max_message_size_option = nullptr;
   size_t max_reported = 100;
   bool parse_only = false;
   bool no_layouts = false;

@@ -87,12 +87,18 @@ struct CheckCommand {
     }
     if (bag || (path != "-" && transport::is_bag(path)))
       return run_bag(properties, bag ? input.substr(input.find(':') + 1) : path, opath);
-    if (path != "-")
+    if (path != "-") {
+      // An empty or cut-short .mcap/.db3 is a bag that failed, not an empty trace.
+      if (const std::string cut = transport::truncated_bag(path); !cut.empty()) {
+        std::fprintf(stderr, "rvc: bag '%s' is %s\n", path.c_str(), cut.c_str());
+        return kUsage;
+      }
       if (const std::string what = transport::binary_signature(path); !what.empty()) {
         std::fprintf(stderr, "rvc: trace '%s' is %s, not JSON lines (rvc check reads JSON lines and ROS 2 bags)\n",
                      path.c_str(), what.c_str());
         return kUsage;
       }
+    }
     if (int status = refuse_input_copies({output}, path == "-" ? "stdin" : path)) return status;
     if (check.calls) {
       std::fprintf(stderr, "rvc: --calls pairs the service events of a bag's topic (or a live input: rvc monitor "

@@ -100,7 +100,9 @@ struct EchoCommand {
     for (const auto& f : fields)
       if (!select(*in.type, f, selection)) return kUsage;
     install_stop_signals();
-    auto reader = transport::open_bag(path);
+    transport::BagReadOptions read;  // the default cap; the other topics' compressed messages stay so
+    read.topics = {in.topic};
+    auto reader = transport::open_bag(path, read);
     uint64_t printed = 0, rejected = 0;
     reader->on_skip([&](const std::string& why) {
       if (++rejected <= 100) std::fprintf(stderr, "rvc: bag '%s': %s\n", path.c_str(), why.c_str());
@@ -145,6 +147,12 @@ struct EchoCommand {
 
   int run() {
     if (const std::string bag = bag_path(); !bag.empty()) return run_bag(bag);
+    if (transport::scheme_of(input) == "file" && input != "-")
+      if (const std::string path = input.rfind("file:", 0) == 0 ? input.substr(5) : input;
+          !transport::truncated_bag(path).empty()) {
+        std::fprintf(stderr, "rvc: bag '%s' is %s\n", path.c_str(), transport::truncated_bag(path).c_str());
+        return kUsage;
+      }
     if (!topic.empty()) {
       std::fprintf(stderr, "rvc: --topic chooses a topic of a bag (bag:PATH, a .mcap or .db3 file, a bag folder)\n");
       return kUsage;

@@ -37,6 +37,7 @@ struct SyncCommand {
   transport::TransportOptions transports;
   std::string time_field = "time";
   size_t max_message_size = 1 << 20;
+  CLI::Option* max_message_size_option = nullptr;
   bool exit_on_eos = false;
   size_t publishers = 1;
   double idle_timeout = 0;
@@ -121,6 +122,7 @@ struct SyncCommand {
     popts.parse_only = true;  // no properties: sets only
     popts.time_field = time_field;
     popts.max_message_size = max_message_size;
+    if (max_message_size_option->count()) popts.max_typed_message_size = max_message_size;
     popts.position_name = files ? "line" : "seq";
     runtime::SyncedPipeline pipeline({}, popts, named, sync.options(named), [](const engine::Verdict&) {},
                                      [&](std::string_view json, double) { sets.put_payload(json); });
@@ -168,9 +170,10 @@ Runner register_sync(CLI::App& app) {
   sub->add_option("--time-field", cmd->time_field, "JSON inputs: the field holding the stamp (seconds)")
       ->check(field_name())
       ->capture_default_str();
-  sub->add_option("--max-message-size", cmd->max_message_size, "Longest accepted message in bytes")
-      ->check(in_range(1, kMaxMessageSize, "bytes"))
-      ->capture_default_str();
+  cmd->max_message_size_option =
+      sub->add_option("--max-message-size", cmd->max_message_size,
+                      "Longest accepted message in bytes (default: 1 MiB for JSON, 256 MiB for typed input)")
+          ->check(in_range(1, kMaxMessageSize, "bytes"));
   sub->add_flag("--exit-on-eos", cmd->exit_on_eos, "Exit after every input's end-of-stream marker");
   sub->add_option("--publishers", cmd->publishers, "With --exit-on-eos: publishers per input to wait for")
       ->check(in_range(1, 100000));

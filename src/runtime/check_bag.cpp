@@ -106,6 +106,10 @@ BagInput select_bag_topic(const std::string& path, const std::string& topic, msg
   return in;
 }
 
+void set_size_cap(BagInput& in, const PipelineOptions& options) {
+  in.max_message_size = in.type ? options.max_typed_message_size : options.max_message_size;
+}
+
 void hint_bag_definition(const BagInput& in) {
   if (!in.bag_definition || !in.type) return;
   std::fprintf(stderr,
@@ -118,7 +122,13 @@ Outcome check_bag(const std::vector<BagInput>& inputs, Feed& feed, VerdictOutput
                   const std::function<bool()>& stop, bool tick_at_end) {
   skipped = 0;
   return run_check(feed, outputs, [&](Outcome& outcome) {
-    std::unique_ptr<transport::BagReader> reader = transport::open_bag(inputs.at(0).path);
+    transport::BagReadOptions read;
+    read.max_message_size = 0;
+    for (const BagInput& in : inputs) {
+      read.max_message_size = std::max(read.max_message_size, in.max_message_size);
+      read.topics.push_back(in.topic);
+    }
+    std::unique_ptr<transport::BagReader> reader = transport::open_bag(inputs.at(0).path, read);
     transport::BagReader& bag = *reader;
     constexpr uint64_t kShown = 100;  // as the pipeline's errors: a bag of bad records does not flood stderr
     bag.on_skip([&](const std::string& reason) {

@@ -22,9 +22,15 @@ struct BagInput {
   const msg::MessageType* type = nullptr;  // CDR samples of this type; null: JSON messages
   uint64_t messages = 0;                 // of that topic
   bool bag_definition = false;           // its definition came from the bag (not --msg-path or bundled)
+  // The run's cap on one message of this topic (--max-message-size): a
+  // compressed message is decompressed only up to it (set_size_cap).
+  size_t max_message_size = size_t{256} << 20;
   // As the bag records the topic (copied with its messages by mcap:PATH?inputs=1).
   std::string type_name, encoding, definition_encoding, definition;
 };
+
+// The cap of `options` that applies to the topic's messages (typed or JSON).
+void set_size_cap(BagInput& in, const PipelineOptions& options);
 
 // When no sample of a topic decoded and its definition came from the bag:
 // the hint that the recorded definition may be wrong (some rosbag2 bags

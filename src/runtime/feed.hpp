@@ -16,6 +16,7 @@ namespace rvc::runtime {
 struct PipelineStats {
   uint64_t accepted = 0;  // messages fed to the monitors
   uint64_t rejected = 0;  // messages refused (malformed, wrong time order, strict-mode problems)
+  uint64_t oversized = 0;  // of the rejected typed samples: over the size cap (no hint about their definition)
   uint64_t warnings = 0;  // fields that kept their previous value (wrong type)
   uint64_t by_layout = 0;  // of the accepted, read by a learned layout without a parse (io/json_layout.hpp)
   // Dense time on a clock: accepted messages stamped at or before the

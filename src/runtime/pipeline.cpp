@@ -424,7 +424,12 @@ bool Pipeline::oversized(std::string_view payload, uint64_t position) {
 
 void Pipeline::feed(std::string_view payload, uint64_t position) {
   if (typed_) {  // one CDR sample per payload (never a batch)
-    if (!oversized(payload, position)) feed_typed(payload, position);
+    if (payload.size() <= options_.max_typed_message_size) return feed_typed(payload, position);
+    ++stats_.oversized;
+    on_error(io::LineError{position, 0,
+                           "a sample of " + std::to_string(payload.size()) + " bytes, over the limit of " +
+                               std::to_string(options_.max_typed_message_size) +
+                               " bytes for typed input (raise it with --max-message-size)"});
     return;
   }
   if (payload.find('\n') != std::string_view::npos) {

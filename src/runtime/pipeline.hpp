@@ -38,6 +38,10 @@ struct PipelineOptions {
   bool explain = false;                // a violation's verdict says why (discrete)
   uint32_t max_data_values = 100000;   // data references: distinct values per variable
   size_t max_message_size = 1 << 20;   // longest message: a line, a payload, a line inside a batched payload
+  // Typed input (a CDR sample, one per payload): the decoder reads only the
+  // tested fields and steps over the rest without copying (an Image's data),
+  // so the cap only bounds memory: well above camera frames and point clouds.
+  size_t max_typed_message_size = size_t{256} << 20;
   bool layouts = true;                 // read lines laid out like earlier ones by position (io/json_layout.hpp)
   // Evaluate comparisons of one field with many constants together and step
   // only the operators whose inputs changed (io/threshold_index.hpp,

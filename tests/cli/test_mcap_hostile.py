@@ -365,3 +365,71 @@ def test_a_chunk_over_the_limit_is_skipped_before_it_is_decompressed(mcap_rvc, t
     assert f"the chunk at offset {pos}: it claims {size} bytes uncompressed, over rvc's limit of 256 MiB for " \
            "one chunk; its records are skipped" in err, err
     assert rss_kib < 200 * 1024, rss_kib
+
+
+@pytest.mark.parametrize("compression", ["none", "zstd"])
+def test_a_record_with_a_bad_length_keeps_the_records_before_it(mcap_rvc, tmp_path, compression):
+    """A message record in the middle of a chunk whose length is patched to 1 TiB: the valid records
+    before it in the same chunk were lost with the chunk (its CRC refused it whole, or its zstd data
+    was refused at the bad record). Now they are checked, the chunk's rest is skipped naming the
+    record's offset, every other chunk is checked. Oracle: the `mcap` package's reader (it gives the
+    damaged record's bytes up to the chunk's end as one more message, which no JSON parser reads)."""
+    rows = [{"p": i != 70, "i": i} for i in range(80)]
+    data = bytearray(open(json_bag(tmp_path / "c.mcap", rows, chunk_size=1024), "rb").read())
+    chunks = [(pos, body, n) for pos, op, body, n in records(data) if op == OP_CHUNK]
+    assert len(chunks) >= 3
+    pos, body, n = chunks[1]
+    inner = [r for r in chunk_records(data, body) if r[1] == OP_MESSAGE]
+    bad_at = inner[len(inner) // 2][0]
+    start = chunk_records(data, body)[0][0]  # the chunk's records begin here
+    struct.pack_into("<Q", data, bad_at + 1, 1 << 40)
+    if compression == "zstd":  # the same records, zstd-compressed, the chunk's sizes and CRC honest
+        end = body + n
+        data = data[:pos] + zstd_chunk(bytes(data[start:end])) + data[end:]
+    bag = tmp_path / "badlen.mcap"
+    bag.write_bytes(bytes(data))
+
+    from mcap.stream_reader import StreamReader
+    from mcap.records import Message
+    want = []
+    with open(bag, "rb") as f:
+        for r in StreamReader(f).records:
+            if isinstance(r, Message):
+                try:
+                    want.append(json.loads(r.data))
+                except ValueError:
+                    pass  # the damaged record
+    assert len(want) > len(rows) - len(inner)  # some of that chunk's records are valid
+
+    r = run([mcap_rvc, "echo", str(bag)])
+    assert r.returncode == 3, r.stderr
+    assert [json.loads(l) for l in r.stdout.splitlines()] == want
+    said = f"the chunk at offset {pos}: " + (
+        "the CRC of its records is " if compression == "none" else "")
+    assert said in r.stderr and f"the message record at offset {bad_at - start} " in r.stderr and \
+        "claims 1099511627776 bytes" in r.stderr and "its records before that one are read, the rest skipped" \
+        in r.stderr, r.stderr
+    c = run([mcap_rvc, "check", "--all", "--stats", "--spec", "{p}", str(bag)])
+    assert c.returncode == 1, c.stderr  # message 70, in the last chunk
+    counters = json.loads(c.stderr.strip().splitlines()[-1])
+    assert (counters["received"], counters["checked"], counters["rejected"]) == (len(want) + 1, len(want), 1)
+    same = run([mcap_rvc, "check", "--all", "--spec", "{p}", json_trace(tmp_path, want)])
+    assert c.stdout == same.stdout
+
+
+@pytest.mark.parametrize("name,content,said", [
+    ("rec.mcap", b"", "is an empty file (0 bytes), not an MCAP file: a recording cut short before its first byte?"),
+    ("rec.mcap", MAGIC[:5], "is a truncated MCAP file: 5 bytes, its 8-byte magic cut short"),
+    ("rec.db3", b"", "is an empty file (0 bytes), not a rosbag2 sqlite3 file"),
+])
+def test_an_empty_or_cut_bag_file_is_named_so(mcap_rvc, tmp_path, name, content, said):
+    """An empty .mcap with --topic was "a JSON-lines trace" (and without --topic "nothing was
+    checked", exit 6): now every command says it is an empty or truncated bag file, exit 2."""
+    bag = tmp_path / name
+    bag.write_bytes(content)
+    for args in (["check", str(bag), "--topic", "/x", "--spec", "{p}"], ["check", str(bag), "--spec", "{p}"],
+                 ["echo", str(bag), "--topic", "/x"], ["bag", "info", str(bag)],
+                 ["monitor", "--input", f"bag:{bag}", "--spec", "{p}"]):
+        r = run([mcap_rvc, *args])
+        assert r.returncode == 2, (args, r.stderr)
+        assert f"bag '{bag}' {said}" in r.stderr and "JSON-lines" not in r.stderr, (args, r.stderr)

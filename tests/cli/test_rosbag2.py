@@ -422,3 +422,59 @@ def test_end_of_recording_tick_on_every_storage(rvc, tmp_path, storage):
     for r in (c, m):
         assert r.returncode == 1, r.stderr
         assert [(v["time"], v["value"]) for v in map(json.loads, r.stdout.splitlines())] == want
+
+
+# --- real-size messages: camera frames are read, their pixels stepped over -------------------------
+
+def write_images(folder, typestore, storage, sizes, compression=None):
+    """sensor_msgs/Image messages (rgb8) of the given (width, height), written by rosbags."""
+    import numpy as np
+    from rosbags.rosbag2 import CompressionFormat, StoragePlugin, Writer
+    Image, Header = typestore.types["sensor_msgs/msg/Image"], typestore.types["std_msgs/msg/Header"]
+    Time = typestore.types["builtin_interfaces/msg/Time"]
+    w = Writer(folder, version=8, storage_plugin=StoragePlugin.SQLITE3 if storage == "sqlite3" else StoragePlugin.MCAP)
+    if compression:
+        w.set_compression(compression, CompressionFormat.ZSTD)
+    with w:
+        c = w.add_connection("/camera/image_raw", Image.__msgtype__, typestore=typestore)
+        for i, (width, height) in enumerate(sizes):
+            img = Image(header=Header(stamp=Time(sec=1_700_000_000 + i, nanosec=0), frame_id="cam"), height=height,
+                        width=width, encoding="rgb8", is_bigendian=0, step=3 * width,
+                        data=np.full(3 * width * height, i, dtype=np.uint8))
+            w.write(c, (1_700_000_000 + i) * 10**9, typestore.serialize_cdr(img, Image.__msgtype__))
+    return str(folder)
+
+
+@pytest.mark.parametrize("storage", STORAGES)
+@pytest.mark.parametrize("compression", [None, "message"])
+def test_camera_frames_are_checked_whole(rvc, humble, tmp_path, storage, compression):
+    """Six 1024x768 rgb8 frames (2.4 MB each, over the 1 MiB that JSON lines keep): every one checked
+    (typed input is capped at 256 MiB by default), exit 0; --max-message-size below a frame's size
+    rejects it, naming its size and the option, and still checks the small frame after it."""
+    needs_mcap(rvc, storage)
+    from rosbags.rosbag2 import CompressionMode
+    mode = {None: None, "message": CompressionMode.MESSAGE}[compression]
+    bag = write_images(tmp_path / "camera", humble, storage, [(1024, 768)] * 6 + [(8, 6)], mode)
+    frame = 4 + len(humble.serialize_cdr(humble.types["sensor_msgs/msg/Image"](
+        header=humble.types["std_msgs/msg/Header"](stamp=humble.types["builtin_interfaces/msg/Time"](sec=0, nanosec=0),
+                                                   frame_id="cam"), height=768, width=1024, encoding="rgb8",
+        is_bigendian=0, step=3072, data=__import__("numpy").zeros(1024 * 768 * 3, dtype="uint8")),
+        "sensor_msgs/msg/Image")) - 4  # the CDR sample's size, as rosbags writes it (header included)
+    assert frame > 2_000_000
+    spec = 'historically({height <= 768} and {width <= 1024} and {header.frame_id == "cam"} and {step == 3 * width})'
+    for args in (["check", bag, "--stats"], ["monitor", "--input", "bag:" + bag]):
+        r = run([rvc, *args, "--spec", spec])
+        assert r.returncode == 0, (args, r.stderr)
+        counters = json.loads(r.stderr.strip().splitlines()[-1])
+        assert (counters["received"], counters["checked"], counters["rejected"]) == (7, 7, 0), (args, counters)
+        assert json.loads(r.stdout.splitlines()[0])["value"] is True
+    small = run([rvc, "check", bag, "--stats", "--spec", spec, "--max-message-size", "1000000"])
+    assert small.returncode == 3, small.stderr
+    said = (f"message 1 on /camera/image_raw: zstd: its frame declares {frame} bytes decompressed, over the limit "
+            "of 1000000 (--max-message-size)") if compression else \
+        f"message 1: a sample of {frame} bytes, over the limit of 1000000 bytes for typed input (raise it with " \
+        "--max-message-size)"
+    assert said in small.stderr, small.stderr
+    assert "--msg-path" not in small.stderr  # no hint that the bag's definition is wrong: only the size is
+    counters = json.loads(small.stderr.strip().splitlines()[-1])
+    assert (counters["received"], counters["checked"], counters["rejected"]) == (7, 1, 6)

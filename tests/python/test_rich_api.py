@@ -175,3 +175,35 @@ def test_check_bag_errors_name_the_problem(humble, tmp_path):
         rvc.check_bag(tmp_path / "b", "{data < 30}", topic="/nope")
     with pytest.raises(ValueError, match="column"):
         rvc.check_bag(tmp_path / "b", "{data < }")
+
+
+def test_camera_frames_and_the_size_cap(humble, tmp_path):
+    """A 1024x768 rgb8 Image (2.4 MB CDR, over JSON's 1 MiB): update_cdr and check_bag check it by
+    default (typed input is capped at 256 MiB); max_message_size= below its size refuses it,
+    naming its size and the option; a cap outside 1 byte..1 GiB is a ValueError."""
+    import numpy as np
+    from rosbags.rosbag2 import StoragePlugin, Writer
+    Image, Header = humble.types["sensor_msgs/msg/Image"], humble.types["std_msgs/msg/Header"]
+    Time = humble.types["builtin_interfaces/msg/Time"]
+    img = Image(header=Header(stamp=Time(sec=1, nanosec=0), frame_id="cam"), height=768, width=1024,
+                encoding="rgb8", is_bigendian=0, step=3072, data=np.zeros(1024 * 768 * 3, dtype=np.uint8))
+    cdr = bytes(humble.serialize_cdr(img, Image.__msgtype__))
+    assert len(cdr) > 2_000_000
+    spec = '{height == 768} and {width == 1024} and {header.frame_id == "cam"}'
+    m = rvc.Monitor(spec, type="sensor_msgs/msg/Image")
+    assert [v.value for v in m.update_cdr("sensor_msgs/msg/Image", cdr)] == [True]
+    capped = rvc.Monitor(spec, type="sensor_msgs/msg/Image", max_message_size=1_000_000)
+    with pytest.raises(ValueError, match=f"a sample of {len(cdr)} bytes, over the limit of 1000000 bytes.*"
+                                         "--max-message-size"):
+        capped.update_cdr("sensor_msgs/msg/Image", cdr)
+    for bad in (0, -1, (1 << 30) + 1, 1.5, True):
+        with pytest.raises(ValueError, match="max_message_size"):
+            rvc.Monitor(spec, max_message_size=bad)
+    with Writer(tmp_path / "camera", version=8, storage_plugin=StoragePlugin.SQLITE3) as w:
+        c = w.add_connection("/camera", Image.__msgtype__, typestore=humble)
+        for i in range(3):
+            w.write(c, 1_000_000_000 + i, cdr)
+    r = rvc.check_bag(tmp_path / "camera", spec)
+    assert (r.received, r.checked, r.rejected, r.exit_code) == (3, 3, 0, 0)
+    r = rvc.check_bag(tmp_path / "camera", spec, max_message_size=1_000_000)
+    assert (r.received, r.checked, r.rejected) == (3, 0, 3) and f"a sample of {len(cdr)} bytes" in r.errors[0]

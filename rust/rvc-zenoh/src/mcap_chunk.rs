@@ -27,6 +27,37 @@ impl ChunkRecords {
             ChunkRecords::Owned(v) => v,
         }
     }
+
+    /// The first `n` bytes only: the records before a damaged one.
+    fn truncated(self, n: usize) -> ChunkRecords {
+        match self {
+            ChunkRecords::Mapped(b) => ChunkRecords::Mapped(&b[..n.min(b.len())]),
+            ChunkRecords::Owned(mut v) => {
+                v.truncate(n);
+                ChunkRecords::Owned(v)
+            }
+        }
+    }
+}
+
+/// A chunk's records that can be read: all of them, or (`damage`) those
+/// before a record whose length is damaged, and why the rest is skipped.
+pub struct Opened {
+    pub records: ChunkRecords,
+    pub damage: Option<String>,
+}
+
+/// Where the records' framing breaks: the offset of the first record whose
+/// length runs past the records, and why. None when every length holds.
+fn framing_break(records: &[u8]) -> Option<(usize, String)> {
+    let mut pos = 0;
+    loop {
+        match rec::record_at(records, pos, "its records") {
+            Ok(None) => return None,
+            Ok(Some(r)) => pos = r.next,
+            Err(e) => return Some((pos, e)),
+        }
+    }
 }
 
 /// Why a chunk is skipped, and how many messages it held if its records
@@ -42,7 +73,15 @@ fn refuse(reason: String) -> ChunkError {
 
 /// The records of the chunk whose record is `record` (opcode, length and body,
 /// as in the file) and whose body is `body`.
-pub fn open(record: &'static [u8], body: &'static [u8]) -> Result<ChunkRecords, ChunkError> {
+///
+/// A record whose length is damaged (it runs past the chunk's records) no
+/// longer costs the valid records before it: they are read (as the `mcap`
+/// readers read them) and the rest of the chunk is skipped, with the
+/// record's offset. That holds also when the chunk's CRC fails, provided
+/// the framing breaks: the damage is then located at that record. A chunk
+/// whose CRC fails while every length holds is refused whole (the damage
+/// could be in any of its messages).
+pub fn open(record: &'static [u8], body: &'static [u8]) -> Result<Opened, ChunkError> {
     let c = rec::chunk(body).map_err(refuse)?;
     let size = c.uncompressed_size;
     let records = match c.compression {
@@ -72,7 +111,14 @@ pub fn open(record: &'static [u8], body: &'static [u8]) -> Result<ChunkRecords, 
             }
             let (records, stopped) = decompress(record, size);
             if let Some(why) = stopped {
-                return Err(refuse(why));
+                // A record's length runs past the records (or past the chunk's
+                // size): the complete records before it are kept, unchecked
+                // by the CRC, which covers the whole chunk.
+                if records.is_empty() || why.starts_with("its records cannot be decompressed") {
+                    return Err(refuse(why));
+                }
+                let damage = format!("{why}: its records before that one are read, the rest skipped");
+                return Ok(Opened { records: ChunkRecords::Owned(records), damage: Some(damage) });
             }
             if records.len() as u64 != size {
                 return Err(refuse(format!("it claims {size} bytes uncompressed, its records hold {}", records.len())));
@@ -85,16 +131,20 @@ pub fn open(record: &'static [u8], body: &'static [u8]) -> Result<ChunkRecords, 
     if c.uncompressed_crc != 0 {
         let crc = crc32(bytes);
         if crc != c.uncompressed_crc {
-            return Err(ChunkError {
-                reason: format!(
-                    "the CRC of its records is {crc:#010x}, the chunk records {:#010x} (the chunk was altered)",
-                    c.uncompressed_crc
-                ),
-                messages: count_messages(bytes),
-            });
+            let altered = format!(
+                "the CRC of its records is {crc:#010x}, the chunk records {:#010x} (the chunk was altered)",
+                c.uncompressed_crc
+            );
+            if let Some((at, why)) = framing_break(bytes) {
+                if at > 0 {
+                    let damage = format!("{altered}, at {why}: its records before that one are read, the rest skipped");
+                    return Ok(Opened { records: records.truncated(at), damage: Some(damage) });
+                }
+            }
+            return Err(ChunkError { reason: altered, messages: count_messages(bytes) });
         }
     }
-    Ok(records)
+    Ok(Opened { records, damage: None })
 }
 
 /// Messages among records that may be damaged: as far as their framing holds.

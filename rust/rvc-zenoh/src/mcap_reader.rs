@@ -68,6 +68,7 @@ struct OpenChunk {
     offset: usize,
     records: ChunkRecords,
     pos: usize,
+    damage: Option<String>, // said after its records: why the chunk's rest is skipped
 }
 
 pub struct rvc_mcap_reader {
@@ -266,8 +267,12 @@ impl rvc_mcap_reader {
         let offset = c.offset;
         match rec::record_at(bytes, c.pos, "its records") {
             Ok(None) => {
+                let damage = c.damage.take();
                 self.chunk = None;
-                Some(Step::Nothing)
+                Some(match damage {
+                    Some(why) => Step::Skipped(format!("the chunk at offset {offset}: {why}")),
+                    None => Step::Nothing,
+                })
             }
             Ok(Some(r)) => {
                 c.pos = r.next;
@@ -296,7 +301,12 @@ impl rvc_mcap_reader {
                 if bytes.len() - self.pos >= 9 && bytes[self.pos] == rec::OP_CHUNK {
                     // A chunk being written when the recording stopped: its
                     // complete records are read first, then the cut is said.
-                    self.chunk = Some(OpenChunk { offset: self.pos, records: mcap_chunk::salvage(&bytes[self.pos..]), pos: 0 });
+                    self.chunk = Some(OpenChunk {
+                        offset: self.pos,
+                        records: mcap_chunk::salvage(&bytes[self.pos..]),
+                        pos: 0,
+                        damage: None,
+                    });
                     self.pos = bytes.len();
                     self.ended = true;
                     self.cut = Some(e);
@@ -329,8 +339,11 @@ impl rvc_mcap_reader {
             return Ok(self.record(&r, None, out));
         }
         match mcap_chunk::open(&bytes[r.start..r.next], r.body) {
-            Ok(records) => {
-                self.chunk = Some(OpenChunk { offset: r.start, records, pos: 0 });
+            Ok(opened) => {
+                if opened.damage.is_some() {
+                    self.chunk_refused = true; // the data section's CRC is then known to fail too
+                }
+                self.chunk = Some(OpenChunk { offset: r.start, records: opened.records, pos: 0, damage: opened.damage });
                 Ok(Step::Nothing)
             }
             Err(e) => {

@@ -1,8 +1,13 @@
 #include "transport/rosbag2/bag_folder.hpp"
 
+#include <sys/stat.h>
 #include <yaml-cpp/yaml.h>
 
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 
 namespace rvc::transport {
 
@@ -11,14 +16,36 @@ std::string scalar(const YAML::Node& n, const char* key) {
   const YAML::Node v = n[key];
   return v && v.IsScalar() ? v.as<std::string>() : "";
 }
+
+// What is wrong with a path that should be a regular file ("" if nothing):
+// stat's own words for a symlink loop or a missing target, never an
+// exception (std::filesystem's throwing calls ended the run uncaught).
+std::string not_a_file(const std::string& path) {
+  struct stat st{};
+  if (::stat(path.c_str(), &st) != 0) return std::strerror(errno);
+  if (S_ISDIR(st.st_mode)) return "it is a folder, not a file";
+  if (!S_ISREG(st.st_mode)) return "it is not a regular file";
+  return "";
+}
 }  // namespace
+
+bool names_entry(const std::string& path) {
+  struct stat st{};
+  return ::lstat(path.c_str(), &st) == 0;  // the entry itself: a dangling link or a loop is there too
+}
 
 BagMetadata read_bag_metadata(const std::string& dir) {
   const std::string file = (std::filesystem::path(dir) / "metadata.yaml").string();
+  if (const std::string why = not_a_file(file); !why.empty())
+    throw BagError("bag '" + dir + "': cannot read " + file + ": " + why);
   BagMetadata md;
   YAML::Node root;
   try {
-    root = YAML::LoadFile(file);
+    std::ifstream in(file, std::ios::binary);
+    std::ostringstream text;
+    text << in.rdbuf();
+    if (!in) throw BagError("bag '" + dir + "': cannot read " + file + ": " + std::strerror(errno));
+    root = YAML::Load(text.str());
   } catch (const YAML::ParserException& e) {
     throw BagError("bag '" + dir + "': metadata.yaml:" + std::to_string(e.mark.line + 1) + ": " + e.msg);
   } catch (const YAML::Exception& e) {
@@ -39,9 +66,12 @@ BagMetadata read_bag_metadata(const std::string& dir) {
       // rosbag2 writes names relative to the folder; older versions wrote
       // the folder's name in front ("bag/bag_0.db3"): take the file's name then.
       std::filesystem::path full = std::filesystem::path(dir) / rel;
-      if (!std::filesystem::exists(full)) full = std::filesystem::path(dir) / std::filesystem::path(rel).filename();
-      if (!std::filesystem::exists(full))
+      if (!names_entry(full.string())) full = std::filesystem::path(dir) / std::filesystem::path(rel).filename();
+      if (!names_entry(full.string()))
         throw BagError("bag '" + dir + "': metadata.yaml lists '" + rel + "', which is not in the folder");
+      if (const std::string why = not_a_file(full.string()); !why.empty())
+        throw BagError("bag '" + dir + "': metadata.yaml lists '" + rel + "', which cannot be read: " + full.string() +
+                       ": " + why);
       md.files.push_back(full.string());
     }
     if (const YAML::Node topics = info["topics_with_message_count"]; topics && topics.IsSequence())

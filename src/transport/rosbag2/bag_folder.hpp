@@ -19,7 +19,12 @@ struct BagMetadata {
   std::vector<BagTopicInfo> topics;  // topics_with_message_count (names, types, counts)
 };
 
-// Reads DIR/metadata.yaml; throws BagError naming the file, line and what is wrong.
+// Whether a folder holds an entry of this name (a symlink loop or a dangling
+// link counts: it is reported as what it is, not as missing). Never throws.
+bool names_entry(const std::string& path);
+
+// Reads DIR/metadata.yaml; throws BagError naming the file, line and what is
+// wrong (a symlink loop, a folder where the file should be, ...).
 BagMetadata read_bag_metadata(const std::string& dir);
 
 // Merges several readers (each in log-time order) into one, in log-time order.

@@ -72,13 +72,14 @@ void merge_topic(std::map<std::string, BagTopicInfo>& into, const BagTopicInfo& 
 // a message whose data is a zstd frame is given decompressed.
 class DecompressingBag : public BagReader {
  public:
-  explicit DecompressingBag(std::unique_ptr<BagReader> inner) : BagReader(inner->path()), inner_(std::move(inner)) {}
+  DecompressingBag(std::unique_ptr<BagReader> inner, const BagReadOptions& options)
+      : BagReader(inner->path()), inner_(std::move(inner)), options_(options) {}
   bool next(BagMessage& m) override {
     inner_->on_skip(on_skip_);
     while (inner_->next(m)) {
-      if (!is_zstd_frame(m.data)) return true;
+      if (!is_zstd_frame(m.data) || !wanted(m.topic)) return true;
       std::string error;
-      if (zstd_decompress(m.data, buffer_, error)) {
+      if (zstd_decompress(m.data, buffer_, error, options_.max_message_size)) {
         m.data = buffer_;
         return true;
       }
@@ -88,7 +89,12 @@ class DecompressingBag : public BagReader {
   }
 
  private:
+  bool wanted(std::string_view topic) const {
+    return options_.topics.empty() ||
+           std::find(options_.topics.begin(), options_.topics.end(), topic) != options_.topics.end();
+  }
   std::unique_ptr<BagReader> inner_;
+  BagReadOptions options_;
   std::string buffer_;
 };
 
@@ -174,13 +180,14 @@ std::unique_ptr<BagReader> open_storage_file(const std::string& path, const std:
 #endif
     default: break;
   }
+  if (const std::string cut = truncated_bag(shown); !cut.empty()) throw BagError("bag '" + shown + "' is " + cut);
   const std::string what = binary_signature(shown);
   throw BagError("'" + shown + "' is not a ROS 2 bag (MCAP, rosbag2 sqlite3 or a bag folder)" +
                  (what.empty() ? std::string() : ": it is " + what));
 }
 
 // One storage file, decompressed first if rosbag2 compressed it whole.
-std::unique_ptr<BagReader> open_file(const std::string& path) {
+std::unique_ptr<BagReader> open_file(const std::string& path, const BagReadOptions& options) {
   std::ifstream probe(path, std::ios::binary);
   if (!probe) throw BagError("bag '" + path + "': cannot open it (" + std::strerror(errno) + ")");
   if (is_zstd_frame(head_of(path, 4))) {
@@ -188,7 +195,7 @@ std::unique_ptr<BagReader> open_file(const std::string& path) {
     auto inner = open_storage_file(copy->path(), path);
     return std::make_unique<CopiedBag>(path, std::move(copy), std::move(inner));
   }
-  return std::make_unique<DecompressingBag>(open_storage_file(path, path));
+  return std::make_unique<DecompressingBag>(open_storage_file(path, path), options);
 }
 
 
@@ -210,6 +217,7 @@ void summarize_file(const std::string& path, BagSummary& s, std::map<std::string
       SqliteBag(file).summarize(one);
       if (s.storage.empty()) s.storage = "sqlite3";
       if (s.broken.empty() && !one.broken.empty()) s.broken = one.broken;
+      if (s.first_skipped.empty() && !one.first_skipped.empty()) s.first_skipped = one.first_skipped;
       for (const auto& t : one.topics) merge_topic(topics, t);
       return;
     }
@@ -233,7 +241,7 @@ const BagTopicInfo* BagSummary::topic(std::string_view name) const {
 
 BagKind bag_kind(const std::string& path) {
   if (is_dir(path))
-    return std::filesystem::exists(std::filesystem::path(path) / "metadata.yaml") ? BagKind::Folder : BagKind::None;
+    return names_entry((std::filesystem::path(path) / "metadata.yaml").string()) ? BagKind::Folder : BagKind::None;
   const std::string head = head_of(path, 16);
   if (is_zstd_frame(head)) {  // rosbag2's per-file compression: name says what is inside
     const std::string name = std::filesystem::path(path).filename().string();
@@ -246,6 +254,31 @@ BagKind bag_kind(const std::string& path) {
     return BagKind::None;
   }
   return file_kind(head);
+}
+
+std::string truncated_bag(const std::string& path) {
+  const std::string name = std::filesystem::path(path).filename().string();
+  auto ends = [&](const char* suffix) {
+    const size_t n = std::strlen(suffix);
+    return name.size() > n && name.compare(name.size() - n, n, suffix) == 0;
+  };
+  const bool zstd = ends(".zstd");
+  const char* magic = nullptr;
+  size_t magic_len = 0;
+  std::string kind;
+  if (ends(".mcap") || ends(".mcap.zstd")) magic = kMcapMagic, magic_len = 8, kind = "an MCAP file";
+  else if (ends(".db3") || ends(".db3.zstd")) magic = kSqliteMagic, magic_len = 16, kind = "a rosbag2 sqlite3 file";
+  else return "";
+  struct stat st{};
+  if (::stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) return "";
+  if (st.st_size == 0) return "an empty file (0 bytes), not " + kind + (zstd ? " compressed with zstd" : "") +
+                              ": a recording cut short before its first byte?";
+  if (zstd) return "";  // what a frame holds is told when it is decompressed
+  const std::string head = head_of(path, magic_len);
+  if (head.size() < magic_len && std::memcmp(head.data(), magic, head.size()) == 0)
+    return "a truncated " + kind.substr(kind.find(' ') + 1) + ": " + std::to_string(head.size()) +
+           " bytes, its " + std::to_string(magic_len) + "-byte magic cut short (a recording cut short?)";
+  return "";
 }
 
 std::string binary_signature(const std::string& path) {
@@ -267,14 +300,14 @@ std::string binary_signature(const std::string& path) {
   return "";
 }
 
-std::unique_ptr<BagReader> open_bag(const std::string& path) {
-  if (!is_dir(path)) return open_file(path);
-  if (!std::filesystem::exists(std::filesystem::path(path) / "metadata.yaml"))
+std::unique_ptr<BagReader> open_bag(const std::string& path, const BagReadOptions& options) {
+  if (!is_dir(path)) return open_file(path, options);
+  if (!names_entry((std::filesystem::path(path) / "metadata.yaml").string()))
     throw BagError("'" + path + "' is a folder without metadata.yaml: not a rosbag2 bag folder (give a .mcap or .db3 "
                    "file of it instead)");
   const BagMetadata md = read_bag_metadata(path);
   std::vector<std::unique_ptr<BagReader>> parts;
-  for (const auto& f : md.files) parts.push_back(open_file(f));
+  for (const auto& f : md.files) parts.push_back(open_file(f, options));
   if (parts.size() == 1) return std::move(parts[0]);
   return std::make_unique<MergedBag>(path, std::move(parts));
 }
@@ -284,7 +317,7 @@ BagSummary summarize_bag(const std::string& path) {
   s.path = path;
   std::map<std::string, BagTopicInfo> topics;
   if (is_dir(path)) {
-    if (!std::filesystem::exists(std::filesystem::path(path) / "metadata.yaml")) open_bag(path);  // throws
+    if (!names_entry((std::filesystem::path(path) / "metadata.yaml").string())) open_bag(path);  // throws
     const BagMetadata md = read_bag_metadata(path);
     s.compression_format = md.compression_format;
     s.compression_mode = md.compression_mode;

@@ -90,8 +90,26 @@ inline bool is_bag(const std::string& path) { return bag_kind(path) != BagKind::
 // refusal where JSON lines are expected, instead of an error per line.
 std::string binary_signature(const std::string& path);
 
+// What a run reads of a bag.
+struct BagReadOptions {
+  // Per-message compression: a message is decompressed (streamed) only up
+  // to this many bytes; a larger one is skipped, named with its index, so
+  // a zstd bomb costs no more memory than this.
+  size_t max_message_size = size_t{256} << 20;
+  // The topics the run reads (empty: all). Compressed messages of other
+  // topics are handed on as they are stored, never decompressed.
+  std::vector<std::string> topics;
+};
+
+// For a regular file whose name says it is a bag (.mcap, .db3, with or
+// without .zstd) but whose bytes are not one because they stop short of the
+// storage's magic (an empty file, a recording cut short at its start): what
+// it is, e.g. "an empty file (0 bytes), not an MCAP file: a recording cut
+// short?". "" otherwise.
+std::string truncated_bag(const std::string& path);
+
 // Opens a bag (throws BagError for what is no bag, naming what it is).
-std::unique_ptr<BagReader> open_bag(const std::string& path);
+std::unique_ptr<BagReader> open_bag(const std::string& path, const BagReadOptions& options = {});
 
 // The bag's topics, types, counts and time span. MCAP: from one pass over
 // its messages; sqlite3: from the database's tables (no pass over the

@@ -1,5 +1,6 @@
 #include "transport/rosbag2/zstd_bag.hpp"
 
+#include <sys/statvfs.h>
 #include <unistd.h>
 #include <zstd.h>
 
@@ -26,8 +27,23 @@ struct DStream {
 };
 }  // namespace
 
-bool zstd_decompress(std::string_view in, std::string& out, std::string& error) {
+bool zstd_decompress(std::string_view in, std::string& out, std::string& error, size_t max_out, bool* too_large) {
   out.clear();
+  if (too_large) *too_large = false;
+  auto over = [&](const std::string& what) {
+    out.clear();
+    out.shrink_to_fit();  // a bomb's partial output is not kept for the next message
+    if (too_large) *too_large = true;
+    error = "zstd: " + what + " (--max-message-size)";
+    return false;
+  };
+  // A frame that says its size up front is refused before any byte is made.
+  const unsigned long long declared = ZSTD_getFrameContentSize(in.data(), in.size());
+  if (declared != ZSTD_CONTENTSIZE_UNKNOWN && declared != ZSTD_CONTENTSIZE_ERROR) {
+    if (declared > max_out) return over("its frame declares " + std::to_string(declared) + " bytes decompressed, over the limit of " +
+                                            std::to_string(max_out));
+    out.reserve(static_cast<size_t>(declared));
+  }
   DStream d;
   ZSTD_inBuffer src{in.data(), in.size(), 0};
   std::vector<char> buf(ZSTD_DStreamOutSize());
@@ -39,6 +55,9 @@ bool zstd_decompress(std::string_view in, std::string& out, std::string& error) 
       error = std::string("zstd: ") + ZSTD_getErrorName(ret) + " near byte " + std::to_string(src.pos);
       return false;
     }
+    if (dst.pos > max_out - out.size())  // streamed: memory stops at the cap, whatever the frame claims
+      return over("it decompresses to more than the limit of " + std::to_string(max_out) +
+                  " bytes (decompression stopped there)");
     out.append(buf.data(), dst.pos);
     if (src.pos == src.size && dst.pos < dst.size) break;  // all input read, nothing more held back
   }
@@ -60,7 +79,7 @@ ZstdFileCopy::ZstdFileCopy(const std::string& compressed) {
   std::unique_ptr<FILE, int (*)(FILE*)> out(::fdopen(fd, "wb"), &std::fclose);
   DStream d;
   std::vector<char> ibuf(ZSTD_DStreamInSize()), obuf(ZSTD_DStreamOutSize());
-  uint64_t offset = 0;
+  uint64_t offset = 0, written = 0, checked_at = 0;
   size_t ret = 0;
   auto fail = [&](const std::string& why) {
     ::unlink(path_.c_str());
@@ -77,6 +96,18 @@ ZstdFileCopy::ZstdFileCopy(const std::string& compressed) {
              std::to_string(offset + src.pos));
       if (dst.pos && std::fwrite(obuf.data(), 1, dst.pos, out.get()) != dst.pos)
         fail("cannot write the decompressed copy to " + path_);
+      written += dst.pos;
+      // A frame of a few KB may expand to any size (RLE blocks): the copy
+      // stops before it fills the disk, leaving 5% of it to everyone else.
+      if (written - checked_at >= (uint64_t{64} << 20)) {
+        checked_at = written;
+        struct statvfs fs{};
+        if (::fstatvfs(fd, &fs) == 0 &&
+            static_cast<uint64_t>(fs.f_bavail) * fs.f_frsize < static_cast<uint64_t>(fs.f_blocks) * fs.f_frsize / 20)
+          fail("its decompressed copy reached " + std::to_string(written) + " bytes in " + path_ +
+               " and would leave less than 5% of that file system free: stopped there (set TMPDIR to a folder "
+               "with more room)");
+      }
       if (src.pos == src.size && dst.pos < dst.size) break;
     }
     offset += src.size;

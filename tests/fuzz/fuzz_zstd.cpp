@@ -1,0 +1,53 @@
+// libFuzzer harness: one message of a bag with rosbag2's per-message
+// compression (compression_mode: message), as transport/rosbag2 undoes it:
+// zstd frames from bytes, decompressed streamed under a cap
+// (transport::zstd_decompress, the cap being --max-message-size).
+//
+// Findings: any crash or sanitizer report, an allocation over the limits
+// (tests/fuzz/resource_limits.hpp: a frame that declares or expands to
+// gigabytes must cost no more than the cap), a run that never ends.
+// Oracle: zstd's one-shot API (ZSTD_decompress into a buffer of the cap):
+// what it decompresses within the cap, the streamed decoder gives byte for
+// byte; what the streamed decoder gives, it gives too; output never passes
+// the cap; a refusal for size names --max-message-size.
+#include <zstd.h>
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "resource_limits.hpp"
+#include "transport/rosbag2/zstd_bag.hpp"
+
+extern "C" int LLVMFuzzerInitialize(int* argc, char*** argv) {
+  rvc::fuzz::add_resource_limits(argc, argv);
+  return 0;
+}
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  // The first byte picks the cap (64 B .. 8 MiB): small caps reach the
+  // refusals, large ones let real frames through.
+  if (size < 1) return 0;
+  const size_t cap = size_t{64} << (data[0] % 18);
+  const std::string_view in(reinterpret_cast<const char*>(data + 1), size - 1);
+  std::string out, error;
+  bool too_large = false;
+  const bool ok = rvc::transport::zstd_decompress(in, out, error, cap, &too_large);
+  if (out.size() > cap) __builtin_trap();
+  if (!ok && error.empty()) __builtin_trap();
+  if (too_large && error.find("--max-message-size") == std::string::npos) __builtin_trap();
+  if (!ok && !out.empty() && too_large) __builtin_trap();  // a refused bomb keeps nothing
+
+  static std::vector<char> ref;
+  ref.resize(cap);
+  const size_t n = ZSTD_decompress(ref.data(), ref.size(), in.data(), in.size());
+  if (!ZSTD_isError(n)) {  // the one-shot API read it whole within the cap
+    if (!ok || out.size() != n || std::string_view(ref.data(), n) != out) __builtin_trap();
+  } else if (ok && !in.empty() && rvc::transport::is_zstd_frame(in)) {
+    // Streamed read it, one-shot did not: only when one-shot's buffer was too small cannot happen
+    // (out fits the cap); zstd's two APIs agree on every other frame.
+    __builtin_trap();
+  }
+  return 0;
+}
