@@ -36,8 +36,9 @@ void Checker::add_property(const PropertySpec& property) {
   options.robustness = robustness_;
   spec::NodePtr ast = spec::parse(property.spec, options);
   const double h = spec::horizon(*ast);
-  if (spec::has_future(*ast)) ast = pastified(*ast, h, property.spec);  // h may be 0: until[0:0]
-  Program program = compile(*ast, atoms_, model_, property.spec);
+  const bool future = spec::has_future(*ast);
+  if (future) ast = pastified(*ast, h, property.spec);  // h may be 0: until[0:0]
+  Program program = compile(*ast, atoms_, model_, property.spec, !future);  // a rewrite's texts: never shown
   if (program.has_data()) {
     if (robustness_)
       throw spec::SpecError("--robustness has no meaning for data references (exists/forall), as in Reelay",
