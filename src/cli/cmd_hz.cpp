@@ -43,6 +43,7 @@
 #include "msg/type_registry.hpp"
 #include "runtime/time_field_reader.hpp"
 #include "runtime/topic_rate.hpp"
+#include "transport/rosbag2/bag_reader.hpp"
 #include "transport/transport_options.hpp"
 
 namespace rvc::cli {
@@ -97,6 +98,7 @@ struct HzCommand {
   bool prepare() {
     for (const auto& p : typed.msg_paths) typed.registry.add_search_path(p);
     for (auto& config : hz_topics(config_path, inputs, flags)) {
+      if (!readable_as_lines(config.uri)) return false;
       auto t = std::make_unique<HzTopic>(config);
       const std::string type_name = config.type.empty() ? typed.type : config.type;
       if (!type_name.empty()) {
@@ -134,6 +136,28 @@ struct HzCommand {
         }
       }
       topics.push_back(std::move(t));
+    }
+    return true;
+  }
+
+  // A file input is JSON lines (or any text lines): a bag or another binary
+  // file is refused by what its first bytes are, as rvc check and rvc echo
+  // do, not counted as "lines" of bytes (a bag gave "received 3353, OK").
+  static bool readable_as_lines(const std::string& uri) {
+    if (transport::scheme_of(uri) != "file" || uri == "-") return true;
+    const std::string path = uri.rfind("file:", 0) == 0 ? uri.substr(5) : uri;
+    if (path == "-") return true;
+    if (transport::is_bag(path)) {
+      const std::string what = transport::binary_signature(path);
+      std::fprintf(stderr,
+                   "rvc hz: '%s' is a ROS 2 bag%s: rvc hz watches live topics and files of JSON lines; a bag's "
+                   "topics, counts and rates: rvc bag info; its timing properties: rvc check (docs/bags.md)\n",
+                   path.c_str(), what.empty() ? " folder" : (" (" + what + ")").c_str());
+      return false;
+    }
+    if (const std::string what = transport::binary_signature(path); !what.empty()) {
+      std::fprintf(stderr, "rvc hz: '%s' is %s, not JSON lines\n", path.c_str(), what.c_str());
+      return false;
     }
     return true;
   }
@@ -301,6 +325,15 @@ struct HzCommand {
 
   // --- the loop --------------------------------------------------------------
 
+  // With --time-source stamps, a message more than this many report periods
+  // after the last report is a jump of the stamps: one report, one line.
+  static constexpr double kMaxCatchUp = 100;
+  // `candidate` if it is after `after`, else the next double: at stamps so
+  // large that the period is below their resolution the boundaries still move.
+  static double next_boundary(double candidate, double after) {
+    return candidate > after ? candidate : std::nextafter(after, std::numeric_limits<double>::infinity());
+  }
+
   int run() {
     if (time_source != "receive" && time_source != "stamps") {
       std::fprintf(stderr, "rvc: --time-source must be receive or stamps, not '%s'\n", time_source.c_str());
@@ -378,11 +411,26 @@ struct HzCommand {
           }
           // Reports due before this message see the topics as they were then.
           if (next_report == kNever) next_report = time + period;
+          if (time >= next_report) {
+            const double due = std::floor((time - next_report) / period) + 1;  // report boundaries passed
+            if (due > kMaxCatchUp) {  // a jump (a simulator reset): one report and one line, not one per period
+              const double last = t.stats.any() ? t.stats.last_arrival() : stamp_now;
+              stamp_now = std::max(stamp_now, next_report);
+              report(next_report, false);
+              publish(next_report, next_report);
+              std::fprintf(stderr,
+                           "rvc hz: %s: the stamps jumped by %s s (from %s to %s): the reports of the %s periods "
+                           "in between are skipped\n",
+                           t.config.uri.c_str(), number_text(time - last).c_str(), number_text(last).c_str(),
+                           number_text(time).c_str(), number_text(due - 1).c_str());
+              next_report = next_boundary(next_report + due * period, time);
+            }
+          }
           while (time >= next_report) {
             stamp_now = std::max(stamp_now, next_report);
             report(next_report, false);
             publish(next_report, next_report);
-            next_report += period;
+            next_report = next_boundary(next_report + period, next_report);
           }
           stamp_now = std::max(stamp_now, time);
           arrival = time;
