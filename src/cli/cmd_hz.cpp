@@ -325,15 +325,6 @@ struct HzCommand {
 
   // --- the loop --------------------------------------------------------------
 
-  // With --time-source stamps, a message more than this many report periods
-  // after the last report is a jump of the stamps: one report, one line.
-  static constexpr double kMaxCatchUp = 100;
-  // `candidate` if it is after `after`, else the next double: at stamps so
-  // large that the period is below their resolution the boundaries still move.
-  static double next_boundary(double candidate, double after) {
-    return candidate > after ? candidate : std::nextafter(after, std::numeric_limits<double>::infinity());
-  }
-
   int run() {
     if (time_source != "receive" && time_source != "stamps") {
       std::fprintf(stderr, "rvc: --time-source must be receive or stamps, not '%s'\n", time_source.c_str());
@@ -361,7 +352,8 @@ struct HzCommand {
       return start + std::chrono::duration_cast<SteadyClock::duration>(std::chrono::duration<double>(s));
     };
     const double kNever = std::numeric_limits<double>::infinity();
-    double next_report = stamps_mode() ? kNever : period;  // stamps: set by the first message
+    double next_report = period;                            // receive: the steady clock's next report
+    runtime::StampSchedule schedule(period);                // stamps: the messages' own
     double stamp_now = -kNever;                             // stamps: the latest time read
     double last_message = 0;                                // steady s, for --idle-timeout
     uint64_t total = 0;
@@ -410,28 +402,19 @@ struct HzCommand {
             continue;
           }
           // Reports due before this message see the topics as they were then.
-          if (next_report == kNever) next_report = time + period;
-          if (time >= next_report) {
-            const double due = std::floor((time - next_report) / period) + 1;  // report boundaries passed
-            if (due > kMaxCatchUp) {  // a jump (a simulator reset): one report and one line, not one per period
-              const double last = t.stats.any() ? t.stats.last_arrival() : stamp_now;
-              stamp_now = std::max(stamp_now, next_report);
-              report(next_report, false);
-              publish(next_report, next_report);
-              std::fprintf(stderr,
-                           "rvc hz: %s: the stamps jumped by %s s (from %s to %s): the reports of the %s periods "
-                           "in between are skipped\n",
-                           t.config.uri.c_str(), number_text(time - last).c_str(), number_text(last).c_str(),
-                           number_text(time).c_str(), number_text(due - 1).c_str());
-              next_report = next_boundary(next_report + due * period, time);
-            }
+          const double last = stamp_now;  // the latest time read before this message
+          const runtime::StampSchedule::Step& due = schedule.step(time);
+          for (double boundary : due.reports) {
+            stamp_now = std::max(stamp_now, boundary);
+            report(boundary, false);
+            publish(boundary, boundary);
           }
-          while (time >= next_report) {
-            stamp_now = std::max(stamp_now, next_report);
-            report(next_report, false);
-            publish(next_report, next_report);
-            next_report = next_boundary(next_report + period, next_report);
-          }
+          if (due.skipped > 0)  // a jump (a simulator reset): one report and one line, not one per period
+            std::fprintf(stderr,
+                         "rvc hz: %s: the stamps jumped by %s s (from %s to %s): the reports of the %s periods "
+                         "in between are skipped\n",
+                         t.config.uri.c_str(), number_text(time - last).c_str(), number_text(last).c_str(),
+                         number_text(time).c_str(), number_text(due.skipped).c_str());
           stamp_now = std::max(stamp_now, time);
           arrival = time;
         }

@@ -75,7 +75,9 @@ bool ServiceCalls::feed(std::string_view json, std::string& error) {
     Order order{t, arrivals_++};
     queue_.emplace(order, std::move(call));
     open_.emplace(std::move(key), order);
-    waiting_.insert(order);
+    // A request stamped before a time already passed (a straggler) may be past its deadline at once.
+    if (t + timeout_ > now_) waiting_.insert(order);
+    else queue_.at(order).timed_out = true;
     ++counts_.requests;
   } else {
     if (open == open_.end()) {

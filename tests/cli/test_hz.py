@@ -349,3 +349,14 @@ def test_a_gzip_file_is_refused(rvc, tmp_path):
     for extra in ([], ["--time-source", "stamps"]):
         r = run(rvc, f"file:{f}", *extra, "--duration", "5", timeout=30)
         assert r.returncode == 2 and f"rvc hz: '{f}' is a gzip file, not JSON lines" in r.stderr, r.stderr
+
+
+def test_stamps_beyond_the_period_s_resolution_still_end(rvc, tmp_path):
+    """At 1e20 s a double resolves 16384 s, far above --period 1: the report boundary still moves
+    (before: boundary + period == boundary, a loop that never ended)."""
+    f = tmp_path / "far.jsonl"
+    f.write_text("".join(json.dumps({"time": t}) + "\n" for t in [1e20, 1e20 + 65536, 1e20 + 131072]))
+    r = run(rvc, f"file:{f}", "--time-source", "stamps", "--json", "--timeout", "0", timeout=30)
+    assert r.returncode == 0, r.stderr
+    reports = [json.loads(line)["t"] for line in r.stdout.splitlines()]
+    assert len(reports) <= 4 and reports == sorted(reports) and reports[-1] == 1e20 + 131072
