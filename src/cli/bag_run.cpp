@@ -1,6 +1,8 @@
 #include "cli/bag_run.hpp"
 
 #include <memory>
+#include <stdexcept>
+#include <string>
 
 #include "cli/signals.hpp"
 #include "runtime/service_call_feed.hpp"
@@ -19,6 +21,9 @@ BagRun run_bag(const std::string& path, const std::vector<std::string>& topics,
     runtime::BagInput bag = runtime::select_bag_topic(path, topics.empty() ? "" : topics[0], registry);
     runtime::set_size_cap(bag, options);
     const bool calls = calls_timeout > 0;
+    if (calls && bag.type)
+      if (std::string why = runtime::not_a_service_event(*bag.type, "topic " + bag.topic); !why.empty())
+        throw std::invalid_argument(why);
     options.type = calls ? nullptr : bag.type;  // --calls: the properties read the calls, JSON
     runtime::Pipeline pipeline(properties, options, on_verdict);
     std::unique_ptr<runtime::ServiceCallFeed> call_feed;

@@ -44,6 +44,7 @@
 #include "msg/type_registry.hpp"
 #include "runtime/time_field_reader.hpp"
 #include "runtime/topic_rate.hpp"
+#include "transport/rosbag2/bag_reader.hpp"
 #include "transport/transport_options.hpp"
 
 namespace rvc::cli {
@@ -98,6 +99,7 @@ struct HzCommand {
   bool prepare() {
     for (const auto& p : typed.msg_paths) typed.registry.add_search_path(p);
     for (auto& config : hz_topics(config_path, inputs, flags)) {
+      if (!readable_as_lines(config.uri)) return false;
       auto t = std::make_unique<HzTopic>(config);
       const std::string type_name = config.type.empty() ? typed.type : config.type;
       if (!type_name.empty()) {
@@ -135,6 +137,28 @@ struct HzCommand {
         }
       }
       topics.push_back(std::move(t));
+    }
+    return true;
+  }
+
+  // A file input is JSON lines (or any text lines): a bag or another binary
+  // file is refused by what its first bytes are, as rvc check and rvc echo
+  // do, not counted as "lines" of bytes (a bag gave "received 3353, OK").
+  static bool readable_as_lines(const std::string& uri) {
+    if (transport::scheme_of(uri) != "file" || uri == "-") return true;
+    const std::string path = uri.rfind("file:", 0) == 0 ? uri.substr(5) : uri;
+    if (path == "-") return true;
+    if (transport::is_bag(path)) {
+      const std::string what = transport::binary_signature(path);
+      std::fprintf(stderr,
+                   "rvc hz: '%s' is a ROS 2 bag%s: rvc hz watches live topics and files of JSON lines; a bag's "
+                   "topics, counts and rates: rvc bag info; its timing properties: rvc check (docs/bags.md)\n",
+                   path.c_str(), what.empty() ? " folder" : (" (" + what + ")").c_str());
+      return false;
+    }
+    if (const std::string what = transport::binary_signature(path); !what.empty()) {
+      std::fprintf(stderr, "rvc hz: '%s' is %s, not JSON lines\n", path.c_str(), what.c_str());
+      return false;
     }
     return true;
   }
@@ -329,7 +353,8 @@ struct HzCommand {
       return start + std::chrono::duration_cast<SteadyClock::duration>(std::chrono::duration<double>(s));
     };
     const double kNever = std::numeric_limits<double>::infinity();
-    double next_report = stamps_mode() ? kNever : period;  // stamps: set by the first message
+    double next_report = period;                            // receive: the steady clock's next report
+    runtime::StampSchedule schedule(period);                // stamps: the messages' own
     double stamp_now = -kNever;                             // stamps: the latest time read
     double last_message = 0;                                // steady s, for --idle-timeout
     uint64_t total = 0;
@@ -378,13 +403,19 @@ struct HzCommand {
             continue;
           }
           // Reports due before this message see the topics as they were then.
-          if (next_report == kNever) next_report = time + period;
-          while (time >= next_report) {
-            stamp_now = std::max(stamp_now, next_report);
-            report(next_report, false);
-            publish(next_report, next_report);
-            next_report += period;
+          const double last = stamp_now;  // the latest time read before this message
+          const runtime::StampSchedule::Step& due = schedule.step(time);
+          for (double boundary : due.reports) {
+            stamp_now = std::max(stamp_now, boundary);
+            report(boundary, false);
+            publish(boundary, boundary);
           }
+          if (due.skipped > 0)  // a jump (a simulator reset): one report and one line, not one per period
+            std::fprintf(stderr,
+                         "rvc hz: %s: the stamps jumped by %s s (from %s to %s): the reports of the %s periods "
+                         "in between are skipped\n",
+                         t.config.uri.c_str(), number_text(time - last).c_str(), number_text(last).c_str(),
+                         number_text(time).c_str(), number_text(due.skipped).c_str());
           stamp_now = std::max(stamp_now, time);
           arrival = time;
         }

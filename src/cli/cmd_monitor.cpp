@@ -623,11 +623,23 @@ struct MonitorCommand {
     }
     if (group.given())
       if (int status = join_group({input})) return status;
-    if (check.calls && typed.given() && !ends_with(typed.type, "_Event"))
+    if (check.calls && typed.given() && !ends_with(typed.type, "_Event")) {
+      if (typed.type.find("/srv/") == std::string::npos) {  // a message type: no service to read
+        std::fprintf(stderr, "rvc: --calls reads a service: --type pkg/srv/Name (its request and reply topics) or "
+                             "pkg/srv/Name_Event (its introspection events); %s is not a service type\n",
+                     typed.type.c_str());
+        return kUsage;
+      }
       return run_service_wire(properties, popts, verdicts, stats_sink.get());
+    }
     popts.type = typed.resolve(input_transports);
     // --calls: the input's events are paired into calls; the properties read the calls (JSON).
     const msg::MessageType* event_type = popts.type;
+    if (check.calls && event_type)
+      if (std::string why = runtime::not_a_service_event(*event_type, "input " + input); !why.empty()) {
+        std::fprintf(stderr, "rvc: %s\n", why.c_str());
+        return kUsage;
+      }
     if (check.calls) {
       if (!forward_property.empty()) {
         std::fprintf(stderr, "rvc: --forward republishes the input's messages; with --calls the properties check calls\n");

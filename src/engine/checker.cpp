@@ -47,8 +47,9 @@ void Checker::add_property(const PropertySpec& property) {
                               " s: dense time is exact to the nanosecond up to 9007199.254740992 s (2^53 ns, about "
                               "104 days), and a horizon must lie within it",
                           property.spec, 1);
-  if (spec::has_future(*ast)) ast = pastified(*ast, h, property.spec);  // h may be 0: until[0:0]
-  Program program = compile(*ast, atoms_, model_, property.spec);
+  const bool future = spec::has_future(*ast);
+  if (future) ast = pastified(*ast, h, property.spec);  // h may be 0: until[0:0]
+  Program program = compile(*ast, atoms_, model_, property.spec, !future);  // a rewrite's texts: never shown
   if (program.has_data()) {
     if (robustness_)
       throw spec::SpecError("--robustness has no meaning for data references (exists/forall), as in Reelay",

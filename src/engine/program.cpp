@@ -9,6 +9,7 @@ struct Compiler {
   AtomTable& atoms;
   TimeModel model;
   const std::string& source;
+  bool texts;
   Program program;
   std::vector<std::pair<std::string, int32_t>> scope;  // quantified variables in scope, innermost last
 
@@ -16,7 +17,7 @@ struct Compiler {
 
   int32_t emit(Instr instr, const spec::Node& node) {
     program.code.push_back(instr);
-    program.text.push_back(spec::to_string(node));
+    program.text.push_back(texts ? spec::to_string(node) : std::string());
     return static_cast<int32_t>(program.code.size() - 1);
   }
 
@@ -90,8 +91,8 @@ struct Compiler {
 
 }  // namespace
 
-Program compile(const spec::Node& root, AtomTable& atoms, TimeModel model, const std::string& source) {
-  Compiler c{atoms, model, source, {}, {}};
+Program compile(const spec::Node& root, AtomTable& atoms, TimeModel model, const std::string& source, bool texts) {
+  Compiler c{atoms, model, source, texts, {}, {}};
   c.visit(root);
   return std::move(c.program);
 }

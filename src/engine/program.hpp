@@ -43,7 +43,11 @@ struct Program {
 };
 
 // Compiles a parsed property. Throws spec::SpecError (pointing into `source`)
-// for constructs the chosen time model cannot evaluate.
-Program compile(const spec::Node& root, AtomTable& atoms, TimeModel model, const std::string& source);
+// for constructs the chosen time model cannot evaluate. `texts` false leaves
+// Program::text empty strings: a bounded-future rewrite (spec/pastify.hpp),
+// which --explain refuses, has up to 65,000 nodes, and printing every
+// sub-formula of it costs its size times its depth (seconds, 200 MB).
+Program compile(const spec::Node& root, AtomTable& atoms, TimeModel model, const std::string& source,
+                bool texts = true);
 
 }  // namespace rvc::engine

@@ -105,6 +105,18 @@ int evaluate_test(const spec::FieldTest& t, const FieldValue& field) {
   return -1;
 }
 
+namespace {
+// A margin that is NaN (a NaN operand, or inf - inf) takes the sign of the
+// Boolean verdict, +inf or -inf: NaN makes every comparison false (but !=),
+// so {x > c} with x NaN is -inf and and/or (min/max) never see a NaN, whose
+// result would depend on the operands' order (docs/semantics.md, "Robustness").
+double signed_margin(double m, const spec::FieldTest& t, const FieldValue& v) {
+  if (!std::isnan(m)) return m;
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  return evaluate_test(t, v) == 1 ? inf : -inf;
+}
+}  // namespace
+
 double test_margin(const spec::FieldTest& t, const FieldValue& field) {
   constexpr double inf = std::numeric_limits<double>::infinity();
   FieldValue converted;  // as evaluate_test: a Boolean against a number literal counts 1 or 0
@@ -115,7 +127,7 @@ double test_margin(const spec::FieldTest& t, const FieldValue& field) {
   switch (t.op) {
     case FOp::Truthy:
       if (v.kind == ValueKind::Bool) return v.b ? 1 : 0;
-      if (v.kind == ValueKind::Number) return v.d;
+      if (v.kind == ValueKind::Number) return signed_margin(v.d, t, v);  // NaN is non-zero: true, +inf
       if (v.kind == ValueKind::Null) return 0;
       break;
     case FOp::Value:  // the number itself, what an expression computes with
@@ -124,16 +136,18 @@ double test_margin(const spec::FieldTest& t, const FieldValue& field) {
       return std::numeric_limits<double>::quiet_NaN();
     case FOp::Lt:
     case FOp::Le:
-      if (number) return t.value.number - v.d;
+      if (number) return signed_margin(t.value.number - v.d, t, v);
       break;
     case FOp::Gt:
     case FOp::Ge:
-      if (number) return v.d - t.value.number;
+      if (number) return signed_margin(v.d - t.value.number, t, v);
       break;
     case FOp::Eq:
-    case FOp::Ne:
-      if (number) return t.op == FOp::Eq ? -std::fabs(v.d - t.value.number) : std::fabs(v.d - t.value.number);
-      break;
+    case FOp::Ne: {
+      if (!number) break;
+      const double gap = std::fabs(v.d - t.value.number);
+      return signed_margin(t.op == FOp::Eq ? -gap : gap, t, v);
+    }
     default: break;
   }
   const int b = evaluate_test(t, v);  // the rest is all or nothing

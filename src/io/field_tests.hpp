@@ -62,8 +62,10 @@ int evaluate_test(const spec::FieldTest& test, const FieldValue& value);
 // {x >= c}: x - c; {x < c}, {x <= c}: c - x; {x == c}: -|x - c|; {x != c}:
 // |x - c|; a Boolean field {p}: 1 or 0; a number {x}: x; string and Boolean
 // equality, presence: +inf or -inf; Value (an expression's field): the
-// number, a Boolean 1 or 0. NaN: a type the test cannot use (as
-// evaluate_test's -1).
+// number, a Boolean 1 or 0. A comparison never gives NaN: where the
+// difference is NaN (a NaN field, inf - inf) the margin is +inf if the test
+// holds, else -inf (NaN fails every comparison but !=). NaN is returned only
+// for a type the test cannot use (as evaluate_test's -1) and for Value.
 double test_margin(const spec::FieldTest& test, const FieldValue& value);
 
 // An array quantifier's fold over the elements of one array (issue 29,

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <tuple>
 
 #include <simdjson.h>
 
@@ -74,6 +75,9 @@ bool ServiceCalls::feed(std::string_view json, std::string& error) {
     Order order{t, arrivals_++};
     queue_.emplace(order, std::move(call));
     open_.emplace(std::move(key), order);
+    // A request stamped before a time already passed (a straggler) may be past its deadline at once.
+    if (t + timeout_ > now_) waiting_.insert(order);
+    else queue_.at(order).timed_out = true;
     ++counts_.requests;
   } else {
     if (open == open_.end()) {
@@ -91,6 +95,7 @@ bool ServiceCalls::feed(std::string_view json, std::string& error) {
       return true;
     }
     call.answered = true;
+    waiting_.erase(open->second);
     ++counts_.responses;
     call.response_ns = t_ns;
     first_of("response", call.response);
@@ -100,26 +105,23 @@ bool ServiceCalls::feed(std::string_view json, std::string& error) {
 }
 
 double ServiceCalls::next_deadline() const {
-  double next = kInf;
-  for (const auto& [order, call] : queue_)
-    if (!call.answered && !call.timed_out) next = std::min(next, call.request_time + timeout_);
-  return next;
+  return waiting_.empty() ? kInf : std::get<0>(*waiting_.begin()) + timeout_;
 }
 
 void ServiceCalls::advance(double now) {
   if (!(now > now_)) return;
   now_ = now;
   bool any = false;
-  for (auto& [order, call] : queue_) {
-    if (call.answered || call.timed_out || call.request_time + timeout_ > now_) continue;
-    call.timed_out = true;
+  while (!waiting_.empty() && !(std::get<0>(*waiting_.begin()) + timeout_ > now_)) {
+    queue_.at(*waiting_.begin()).timed_out = true;
+    waiting_.erase(waiting_.begin());
     any = true;
   }
   if (any) flush();
   // Forget calls made long ago: a later event of one of them is then an orphan.
-  for (auto it = done_.begin(); it != done_.end();) {
-    if (it->second.request_time + 4 * timeout_ < now_) it = done_.erase(it);
-    else ++it;
+  while (!done_by_time_.empty() && done_by_time_.begin()->first + 4 * timeout_ < now_) {
+    done_.erase(done_by_time_.begin()->second);
+    done_by_time_.erase(done_by_time_.begin());
   }
 }
 
@@ -139,7 +141,8 @@ void ServiceCalls::flush() {
     if (!call.request.empty()) out.add_raw("request", call.request);
     if (!call.response.empty()) out.add_raw("response", call.response);
     (call.answered ? counts_.answered : counts_.unanswered)++;
-    done_[call.key] = Made{call.request_time, call.answered};
+    done_[call.key] = Made{call.request_time, call.answered};  // a key made is never open again until forgotten
+    done_by_time_.emplace(call.request_time, call.key);
     open_.erase(call.key);
     queue_.erase(it);
     emit_(out.str());

@@ -4,10 +4,24 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 
 #include "io/cdr_codec.hpp"
 
 namespace rvc::runtime {
+
+std::string not_a_service_event(const msg::MessageType& type, const std::string& what) {
+  auto has = [&](const char* name, const char* type_suffix) {
+    for (const auto& f : type.fields)
+      if (f.name == name)
+        return type_suffix == nullptr || (f.type.type_name.size() >= std::strlen(type_suffix) &&
+                                          f.type.type_name.ends_with(type_suffix));
+    return false;
+  };
+  if (has("info", "ServiceEventInfo") && has("request", nullptr) && has("response", nullptr)) return "";
+  return "--calls pairs the events of a service (pkg/srv/Name_Event: info, request, response, on "
+         "/SERVICE/_service_event); " + what + " is " + type.full_name() + ", not a service event type";
+}
 
 ServiceCallFeed::ServiceCallFeed(Pipeline& inner, const msg::MessageType* event_type, double timeout,
                                  size_t max_reported)

@@ -27,6 +27,11 @@
 
 namespace rvc::runtime {
 
+// Empty if `type` is a service event type (fields info: ServiceEventInfo,
+// request, response); else why not, naming `what` ("topic /chatter"): a
+// topic of another type is refused at the start, not blamed on its definition.
+std::string not_a_service_event(const msg::MessageType& type, const std::string& what);
+
 class ServiceCallFeed final : public Feed {
  public:
   // `event_type`: the events are CDR samples of this pkg/srv/Name_Event

@@ -144,4 +144,35 @@ RateSummary TopicRate::summary(double now) const {
   return s;
 }
 
+namespace {
+// `candidate` if it is after `after`, else the next double after `after`.
+double after_(double candidate, double after) {
+  return candidate > after ? candidate : std::nextafter(after, std::numeric_limits<double>::infinity());
+}
+}  // namespace
+
+const StampSchedule::Step& StampSchedule::step(double time) {
+  step_.reports.clear();
+  step_.skipped = 0;
+  if (!std::isfinite(time)) return step_;  // callers refuse such times first; no boundary moves to NaN
+  if (!started()) {
+    next_ = after_(time + period_, time);
+    return step_;
+  }
+  if (!(time >= next_)) return step_;  // NaN too: callers refuse it first
+  const double due = std::floor((time - next_) / period_) + 1;  // boundaries passed
+  if (due > kMaxCatchUp) {
+    step_.reports.push_back(next_);
+    step_.skipped = due - 1;
+    const double next = next_ + due * period_;  // inf for a jump past the doubles' range of periods
+    next_ = after_(std::isfinite(next) ? next : time, time);
+    return step_;
+  }
+  while (time >= next_) {
+    step_.reports.push_back(next_);
+    next_ = after_(next_ + period_, next_);
+  }
+  return step_;
+}
+
 }  // namespace rvc::runtime

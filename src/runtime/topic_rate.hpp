@@ -115,4 +115,31 @@ class TopicRate {
   SlidingExtremum interval_min_{false}, interval_max_{true}, latency_max_{true};
 };
 
+// `rvc hz --time-source stamps`: the reports fall on period boundaries of the
+// messages' own times. step(time) gives the boundaries a message at `time`
+// passes (each report is due before that message is counted), at most
+// kMaxCatchUp of them: a message further ahead is a jump of the stamps (a
+// simulator reset), which gives one report, at the first boundary, and the
+// count of the boundaries skipped; the schedule goes on from the first
+// boundary after `time`. Boundaries always move forward, even where the
+// period is below the stamps' resolution (1e20 s).
+class StampSchedule {
+ public:
+  static constexpr double kMaxCatchUp = 100;
+  explicit StampSchedule(double period) : period_(period) {}
+
+  struct Step {
+    std::vector<double> reports;  // the boundaries passed, in order (at most kMaxCatchUp)
+    double skipped = 0;           // > 0: a jump; the boundaries skipped after reports' one
+  };
+  // `time` >= every earlier one (callers refuse the others).
+  const Step& step(double time);
+  bool started() const { return next_ != std::numeric_limits<double>::infinity(); }
+
+ private:
+  double period_;
+  double next_ = std::numeric_limits<double>::infinity();  // set by the first message
+  Step step_;
+};
+
 }  // namespace rvc::runtime

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <string>
 #include <utility>
 
@@ -26,6 +27,104 @@ bool has_future(const Node& n) {
 }
 
 namespace {
+
+void check_until(const Node& n, bool dense, const std::string& source) {
+  if (dense)
+    throw SpecError("'until' is not supported in dense time yet (RTAMT's dense monitors lack it too); "
+                    "use discrete time, or eventually/always",
+                    source, n.column);
+  if (n.bounds.hi - n.bounds.lo >= kMaxUntilWindow)
+    throw SpecError("until[a:b] with b - a >= " + std::to_string(static_cast<int>(kMaxUntilWindow)) +
+                        " is not supported: it is checked as b - a + 1 terms",
+                    source, n.column);
+}
+
+// A delay computed by subtracting dense bounds may miss the operand's
+// horizon by a rounding error: snap to it (delays are never below it).
+double snap(double d, double h) {
+  if (std::abs(d - h) <= 1e-9 * std::max(1.0, std::abs(d))) return h;
+  return d;
+}
+double delay_of(const Node& n, double d) {
+  d = snap(d, horizon(n));
+  return d < 1e-12 ? 0 : d;
+}
+
+// Node counts saturate here (far above any limit), so that nesting cannot overflow them.
+constexpr uint64_t kSaturated = uint64_t{1} << 62;
+uint64_t add(uint64_t a, uint64_t b) { return std::min(kSaturated, a + b); }  // both <= kSaturated: no overflow
+
+SpecError too_large(uint64_t nodes, uint64_t limit, const std::string& source, int column) {
+  const std::string n = nodes >= kSaturated ? "more than " + std::to_string(kSaturated) : std::to_string(nodes);
+  return SpecError("property too large: its rewrite into past operators would need " + n +
+                       " operators, the limit is " + std::to_string(limit) +
+                       " (until[a:b] is checked as b - a + 1 terms, each with a copy of its operands: "
+                       "nesting multiplies them); narrow the bounds or split the property",
+                   source, column);
+}
+
+// The number of nodes Pastifier::visit(n, d) makes, computed without making
+// them (Pastifier's rules, node for node: tests/unit/future_test.cpp checks
+// that they agree). until[a:b] copies its operands into each of its b − a + 1
+// terms, so nesting multiplies: this is linear in the formula, the rewrite is
+// not. Throws SpecError at the column of an until whose rewrite alone is past
+// `limit`, and the checks of until (dense time, width) first.
+struct Sizer {
+  bool dense;
+  const std::string& source;
+  uint64_t limit;
+
+  static uint64_t delayed(double d) { return d > 0 ? 1 : 0; }                 // the once[d:d] over it
+  static uint64_t ended(double e) { return 1 + delayed(e); }                  // the end marker, delayed
+  static uint64_t started(double d) { return d > 0 ? 3 : 0; }                 // and + once[d:] + true
+  static uint64_t not_started(double d) { return d > 0 ? 4 : 0; }             // or + not + once[d:] + true
+
+  uint64_t visit(const Node& n, double d) {
+    d = delay_of(n, d);
+    switch (n.op) {
+      case Op::True:
+      case Op::False: return 1;
+      case Op::Test: return 1 + delayed(d);
+      case Op::Not:
+      case Op::Exists:
+      case Op::Forall: return add(1, visit(*n.left, d));
+      case Op::And:
+      case Op::Or:
+      case Op::Implies: return add(1, add(visit(*n.left, d), visit(*n.right, d)));
+      case Op::Pre:
+      case Op::Once: return add(1 + started(d), visit(*n.left, d));
+      case Op::Historically: return add(1 + not_started(d), visit(*n.left, d));
+      case Op::Since: return add(1 + started(d), add(visit(*n.left, d), visit(*n.right, d)));
+      case Op::Eventually: {
+        const double e = d - n.bounds.hi;
+        return add(2 + ended(e) + window(n), visit(*n.left, e));
+      }
+      case Op::Always: {
+        const double e = d - n.bounds.hi;
+        return add(1 + ended(e) + window(n), visit(*n.left, e));
+      }
+      case Op::Next: return add(2 + ended(d - 1), visit(*n.left, d - 1));
+      case Op::Until: return until(n, d);
+    }
+    return 1;
+  }
+  static uint64_t window(const Node& n) { return n.bounds.hi - n.bounds.lo > 0 ? 1 : 0; }
+
+  uint64_t until(const Node& n, double d) {
+    check_until(n, dense, source);
+    const double a = n.bounds.lo, b = n.bounds.hi, w = b - a, e = d - b;
+    const uint64_t witness = add(2 + ended(e), visit(*n.right, e));  // and, not, end marker; ψ
+    const uint64_t held = add(2, visit(*n.left, e));                 // and, historically; φ
+    uint64_t total = 0, terms = 0;
+    for (double k = 0; k <= w; ++k, ++terms) {
+      total = add(total, add(witness, delayed(w - k)));
+      if (a + k > 0) total = add(total, held);
+    }
+    total = add(total, terms - 1);  // the ors between the terms
+    if (total > limit) throw too_large(total, limit, source, n.column);
+    return total;
+  }
+};
 
 struct Pastifier {
   const FieldTest& end;
@@ -64,16 +163,8 @@ struct Pastifier {
   static NodePtr either(NodePtr a, NodePtr b, int column) { return node(Op::Or, column, std::move(a), std::move(b)); }
   static NodePtr negate(NodePtr a, int column) { return node(Op::Not, column, std::move(a)); }
 
-  // A delay computed by subtracting dense bounds may miss the operand's
-  // horizon by a rounding error: snap to it (delays are never below it).
-  static double snap(double d, double h) {
-    if (std::abs(d - h) <= 1e-9 * std::max(1.0, std::abs(d))) return h;
-    return d;
-  }
-
   NodePtr visit(const Node& n, double d) {
-    d = snap(d, horizon(n));
-    if (d < 1e-12) d = 0;
+    d = delay_of(n, d);
     const int c = n.column;
     switch (n.op) {
       case Op::True:
@@ -151,15 +242,8 @@ struct Pastifier {
   // in 0..w and [t−d, J) is [t−b, t−(w−k)−1] in monitor time.
   NodePtr until(const Node& n, double d) {
     const int c = n.column;
-    if (dense)
-      throw SpecError("'until' is not supported in dense time yet (RTAMT's dense monitors lack it too); "
-                      "use discrete time, or eventually/always",
-                      source, c);
+    check_until(n, dense, source);
     const double a = n.bounds.lo, b = n.bounds.hi, w = b - a;
-    if (w >= kMaxUntilWindow)
-      throw SpecError("until[a:b] with b - a >= " + std::to_string(static_cast<int>(kMaxUntilWindow)) +
-                          " is not supported: it is checked as b - a + 1 terms",
-                      source, c);
     const double e = d - b;
     NodePtr result;
     for (double k = 0; k <= w; ++k) {
@@ -180,7 +264,15 @@ struct Pastifier {
 
 }  // namespace
 
+uint64_t pastified_size(const Node& root, double h, bool dense, const std::string& source) {
+  return Sizer{dense, source, kSaturated}.visit(root, h);
+}
+
 NodePtr pastify(const Node& root, double h, const FieldTest& end_marker, bool dense, const std::string& source) {
+  // The size first: a rewrite past the limit is refused before it is made
+  // (nested until[0:255] would otherwise take minutes and gigabytes to build).
+  if (const uint64_t n = Sizer{dense, source, kMaxPastifiedNodes}.visit(root, h); n > kMaxPastifiedNodes)
+    throw too_large(n, kMaxPastifiedNodes, source, root.column);
   Pastifier p{end_marker, dense, source};
   return p.visit(root, h);
 }

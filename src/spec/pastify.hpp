@@ -28,6 +28,8 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
+#include <string>
 
 #include "spec/ast.hpp"
 
@@ -42,9 +44,21 @@ bool has_future(const Node& node);
 // first witness of a sliding window in O(1)): wider windows are refused.
 inline constexpr double kMaxUntilWindow = 256;
 
+// The most nodes a rewrite may have: what one property alone may take in a
+// discrete monitor (engine/discrete/monitor.cpp: 65535 slots, two of them the
+// constants), and far below what makes building it slow.
+inline constexpr uint64_t kMaxPastifiedNodes = 65000;
+
+// The number of nodes pastify(root, h, ...) makes, computed in time linear in
+// `root` without making them (saturating at 2^62). Throws pastify's SpecErrors
+// about until (dense time, window width).
+uint64_t pastified_size(const Node& root, double h, bool dense, const std::string& source);
+
 // Rewrites `root` (horizon h > 0) into a past-only formula whose value at t is
 // root's at t − h. `end_marker` is the end-of-stream atom (see above); `dense`
-// refuses `until` (no finite rewrite). Throws SpecError with the column.
+// refuses `until` (no finite rewrite). A rewrite of more than
+// kMaxPastifiedNodes nodes is refused before it is made. Throws SpecError
+// with the column.
 NodePtr pastify(const Node& root, double h, const FieldTest& end_marker, bool dense, const std::string& source);
 
 }  // namespace rvc::spec

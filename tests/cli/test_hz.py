@@ -292,3 +292,71 @@ def test_plain_text_payloads_are_counted_without_latency(rvc, tmp_path):
     assert r.returncode == 3
     final = json.loads(r.stdout.splitlines()[-1])
     assert (final["received"], final["checked"], final["rejected"]) == (3, 1, 2)
+
+
+def test_a_stamp_jump_is_one_report_and_one_line(rvc, tmp_path):
+    """--time-source stamps, a jump of 1e9 s (a simulator reset) after 1 s of messages: the reports at
+    1 and 2 (the state before the jump), one line saying the stamps jumped and by how much, then the
+    reports of the new stamps' boundaries and the final one. Before: one report per period boundary
+    of the 1e9 s, ~1e9 lines, never ending (a bounded harness timeout here)."""
+    f = tmp_path / "jump.jsonl"
+    times = [0, 0.5, 1.0, 1e9 + 1.0, 1e9 + 1.5, 1e9 + 2.6]
+    f.write_text("".join(json.dumps({"time": t}) + "\n" for t in times))
+    r = run(rvc, f"file:{f}", "--time-source", "stamps", "--json", "--timeout", "0", timeout=30)
+    assert r.returncode == 0, r.stderr
+    reports = [json.loads(line) for line in r.stdout.splitlines()]
+    # boundary 1 (before the message at 1.0), the jump's one report at 2, then the new stamps'
+    # boundary 1e9 + 2 (before the message at 1e9 + 2.6), and the final report
+    assert [p["t"] for p in reports] == [1, 2, 1e9 + 2, 1e9 + 2.6]
+    assert [p["received"] for p in reports] == [2, 3, 5, 6]
+    assert reports[-1]["final"] is True
+    jumped = [line for line in r.stderr.splitlines() if "jumped" in line]
+    assert jumped == [f"rvc hz: file:{f}: the stamps jumped by 1e+09 s (from 1 to 1000000001): the reports of the "
+                      "999999999 periods in between are skipped"]
+
+
+def test_a_gap_of_a_few_periods_still_reports_each_period(rvc, tmp_path):
+    f = tmp_path / "gap.jsonl"
+    f.write_text("".join(json.dumps({"time": t}) + "\n" for t in [0, 0.5, 5.5]))
+    r = run(rvc, f"file:{f}", "--time-source", "stamps", "--json", timeout=30)
+    reports = [json.loads(line) for line in r.stdout.splitlines()]
+    assert [p["t"] for p in reports] == [1, 2, 3, 4, 5, 5.5]
+    assert [p["state"] for p in reports[:3]] == ["OK", "Timeout", "Timeout"]  # silence past the 1 s timeout
+    assert "jumped" not in r.stderr
+
+
+BAGS = __import__("pathlib").Path(__file__).resolve().parent.parent / "data" / "ros2-bags"
+
+
+@pytest.mark.parametrize("bag,what", [
+    (BAGS / "talker_mcap" / "talker.mcap", "is a ROS 2 bag (an MCAP file)"),
+    (BAGS / "talker_sqlite3" / "talker.db3", "is a ROS 2 bag (a SQLite database)"),
+    (BAGS / "talker_mcap", "is a ROS 2 bag folder"),
+])
+def test_a_bag_is_refused_not_read_as_lines(rvc, bag, what):
+    """Before: the bag's bytes were counted as lines, "received 3353, final state OK", exit 0."""
+    for uri in (f"file:{bag}", str(bag)):
+        r = run(rvc, uri, "--time-source", "stamps", timeout=30)
+        assert r.returncode == 2, r.stderr
+        assert f"rvc hz: '{bag}' {what}: rvc hz watches live topics and files of JSON lines" in r.stderr
+        assert r.stdout == "" and "received" not in r.stderr
+
+
+def test_a_gzip_file_is_refused(rvc, tmp_path):
+    import gzip
+    f = tmp_path / "trace.jsonl.gz"
+    f.write_bytes(gzip.compress(b'{"time": 0}\n{"time": 0.1}\n'))
+    for extra in ([], ["--time-source", "stamps"]):
+        r = run(rvc, f"file:{f}", *extra, "--duration", "5", timeout=30)
+        assert r.returncode == 2 and f"rvc hz: '{f}' is a gzip file, not JSON lines" in r.stderr, r.stderr
+
+
+def test_stamps_beyond_the_period_s_resolution_still_end(rvc, tmp_path):
+    """At 1e20 s a double resolves 16384 s, far above --period 1: the report boundary still moves
+    (before: boundary + period == boundary, a loop that never ended)."""
+    f = tmp_path / "far.jsonl"
+    f.write_text("".join(json.dumps({"time": t}) + "\n" for t in [1e20, 1e20 + 65536, 1e20 + 131072]))
+    r = run(rvc, f"file:{f}", "--time-source", "stamps", "--json", "--timeout", "0", timeout=30)
+    assert r.returncode == 0, r.stderr
+    reports = [json.loads(line)["t"] for line in r.stdout.splitlines()]
+    assert len(reports) <= 4 and reports == sorted(reports) and reports[-1] == 1e20 + 131072

@@ -370,3 +370,17 @@ def test_a_call_never_checked_is_not_a_clean_pass(rvc, tmp_path):
             assert r.returncode == 0 and counters["dropped"] == {}, r.stderr
         else:
             assert r.returncode == 3 and counters["dropped"] == {reason: 1}, r.stderr
+
+
+@pytest.mark.needs_rust
+def test_calls_on_a_topic_that_is_no_service_event_is_refused_naming_its_type(rvc):
+    """--calls on the bag's /test_topic1 (test_msgs/msg/Strings): refused at the start (exit 2), saying
+    the topic's type is no service event type; before, every message was rejected (exit 6) and the
+    bag's definition was blamed ("if that definition is wrong or cut short ...")."""
+    for args in ([rvc, "check", str(SERVICE_BAG)], [rvc, "monitor", "--input", f"bag:{SERVICE_BAG}"]):
+        r = run(args + ["--topic", "/test_topic1", "--calls", "--spec", "{answered}"], check=2)
+        assert "topic /test_topic1 is test_msgs/msg/Strings, not a service event type" in r.stderr, r.stderr
+        assert "definition" not in r.stderr and r.stdout == ""
+    r = run([rvc, "monitor", "--input", "dds:/chatter", "--type", "std_msgs/msg/String", "--calls",
+             "--spec", "{answered}"], check=2)
+    assert "std_msgs/msg/String is not a service type" in r.stderr, r.stderr

@@ -138,3 +138,18 @@ TEST(ServiceCalls, LinesThatAreNoEventAreRejectedByName) {
 }
 
 }  // namespace
+
+// A straggler request stamped before the clock's time, already past its
+// deadline: made unanswered at once (before, only when a later event or tick
+// moved the clock again), so next_deadline() never lies in the past.
+TEST(ServiceCalls, AStragglerPastItsDeadlineIsMadeAtOnce) {
+  Trace r(0.5);
+  r.feed(event(0, 1000, 1, 1));
+  r.feed(event(3, 1100, 1, 1));  // call 1 answered
+  r.feed(event(0, 3000, 2, 1));  // call 2 at 3.0: the clock is at 3.0
+  ASSERT_EQ(r.out.size(), 1u);
+  r.feed(event(0, 2000, 3, 1));  // stamped 2.0: its deadline 2.5 has passed
+  ASSERT_EQ(r.out.size(), 2u);
+  EXPECT_NE(r.out[1].find("\"request_time\":2,\"answered\":false"), std::string::npos) << r.out[1];
+  EXPECT_EQ(r.calls.next_deadline(), 3.5);  // call 2's
+}

@@ -187,8 +187,11 @@ def test_monitor_calls_reads_the_request_and_reply_topics_of_a_service(rvc, tmp_
         message: str
 
     domain = 50 + os.getpid() % 50
+    # Samples are stamped when rvc's engine takes them: on a loaded machine a reply may come a second or
+    # more after its request, so a 1 s timeout judged an answered call unanswered; 10 s leaves room for
+    # that, and the never-answered request is still reported at its deadline, within read_lines' guard.
     mon = subprocess.Popen([rvc, "monitor", "--input", "dds:/set_bool", "--type", "std_srvs/srv/SetBool", "--calls",
-                            "--service-timeout", "1", "--all", "--spec", "{answered} and {response.success}",
+                            "--service-timeout", "10", "--all", "--spec", "{answered} and {response.success}",
                             "--spec", "{request.data}", "--domain", str(domain)],
                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
