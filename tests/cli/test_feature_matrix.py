@@ -13,7 +13,7 @@ features on every input kind is one cell:
   or inputs involved, and no internal name (the end-of-stream marker atom, C++ exception text).
 
 Any other outcome (a crash, exit 3/5/6, verdicts and then exit 2, a message leaking an internal
-name) fails the cell. Cells that other branches are fixing are xfail(strict=True), naming the bug.
+name) fails the cell. 
 """
 from __future__ import annotations
 
@@ -66,18 +66,11 @@ def cell_id(kind, feats):
     return kind + ":" + ("+".join(f for f in FEATURES if f in feats) or "plain")
 
 
-# Known bugs being fixed on other branches (issue 36): the cells they break, xfail(strict) so the lead
-# flips them after the merge. Each entry: (predicate on kind and features, reason).
-BLOCKED = {"data", "explain"}  # refused with a future operator whatever the input (docs/semantics.md)
-KNOWN = [
-    (lambda kind, f: "future" in f and kind in ("db3", "mcap", "monitor_bag") and not f & (BLOCKED | {"instances"}),
-     "issue 36: bounded future on a typed single-topic input is refused with an internal name "
-     "('no field rvc-end-of-stream in ...'); fixed on another branch"),
-    (lambda kind, f: "future" in f and "instances" in f and kind in ("jsonl", "stdin", "monitor_file")
-     and not f & (BLOCKED | {"clock"}),
-     "issue 36: --instances-by with bounded future never settles an instance's last horizon (a verdict "
-     "lost); fixed on another branch"),
-]
+# Cells refused with a future operator whatever the input (docs/semantics.md). The two bugs this
+# matrix found (bounded future on typed single-topic input, --instances-by with bounded future) are
+# fixed (issue 36): no cell is expected to fail.
+BLOCKED = {"data", "explain"}
+KNOWN = []
 
 
 def params():
