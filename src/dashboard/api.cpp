@@ -102,22 +102,23 @@ const std::string* param(const Params& params, const std::string& name) {
   return it == params.end() ? nullptr : &it->second;
 }
 
-// A non-negative integer of plain digits (an id, a limit).
-int64_t integer_param(const Params& params, const std::string& name, int64_t fallback, int64_t max) {
+// An integer of plain digits from `min` to `max` (an id, a limit); the one
+// message for anything else names that range.
+int64_t integer_param(const Params& params, const std::string& name, int64_t fallback, int64_t max,
+                      int64_t min = 0) {
   const std::string* text = param(params, name);
   if (!text) return fallback;
   int64_t v = -1;
   const char* end = text->data() + text->size();
   auto [ptr, ec] = std::from_chars(text->data(), end, v);
-  if (text->empty() || (*text)[0] == '-' || ec != std::errc() || ptr != end || v > max)
-    throw BadRequest{name + " must be an integer from 0 to " + std::to_string(max) + ", not '" + *text + "'"};
+  if (text->empty() || (*text)[0] == '-' || ec != std::errc() || ptr != end || v > max || v < min)
+    throw BadRequest{name + " must be an integer from " + std::to_string(min) + " to " + std::to_string(max) +
+                     ", not '" + *text + "'"};
   return v;
 }
 
 int64_t limit_param(const Params& params, int64_t fallback, int64_t max) {
-  const int64_t limit = integer_param(params, "limit", fallback, max);
-  if (limit == 0) throw BadRequest{"limit must be at least 1"};
-  return limit;
+  return integer_param(params, "limit", fallback, max, 1);
 }
 
 constexpr int64_t kMaxId = INT64_MAX / 2;

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "dashboard/api.hpp"
+#include "dashboard/deadline_server.hpp"
 #include "store/database.hpp"
 
 namespace rvc::dashboard {
@@ -31,8 +32,13 @@ using Clock = std::chrono::steady_clock;
 constexpr auto kKeepAlive = std::chrono::seconds(2);  // a comment line this often: proxies keep the stream,
                                                       // and a closed client shows as a failed write
 constexpr size_t kIdleConnections = 4;
-constexpr time_t kIdleSeconds = 2;   // longest silence of a client before its connection is closed
-constexpr size_t kApiThreads = 24;   // server threads besides those of event streams
+// A connection's whole request (line, headers, body) must arrive within this
+// of its accept, however slowly its bytes come (DeadlineServer).
+constexpr auto kRequestDeadline = std::chrono::seconds(4);
+constexpr auto kWriteTimeout = std::chrono::seconds(5);  // each write of a response
+// Server threads besides those of event streams: enough that slow clients
+// (each cut off at the deadline) leave threads for the API meanwhile.
+constexpr size_t kApiThreads = 56;
 
 // Database connections, one per request at a time (Database is not
 // thread-safe); idle ones are kept, so a poll does not reopen the file.
@@ -150,7 +156,7 @@ struct DashboardServer::Impl {
 
   ServerOptions options;
   Pool pool;
-  httplib::Server http;
+  DeadlineServer http{kRequestDeadline, kWriteTimeout};
   int port = -1;
   std::string description;
   std::atomic<int> streams{0};
@@ -202,6 +208,19 @@ void DashboardServer::Impl::routes() {
   });
   http.Get("/api/events", [this](const httplib::Request& req, httplib::Response& res) { serve_events(req, res); });
   http.Get(R"(/api/.*)", [this](const httplib::Request& req, httplib::Response& res) { serve_api(req, res); });
+  // Read-only: every other method is 405 with the methods there are (not a
+  // 404, which would say the page does not exist). A body is read before the
+  // handler, so it is kept small.
+  auto read_only = [](const httplib::Request& req, httplib::Response& res) {
+    res.set_header("Allow", "GET, HEAD");
+    reply(res, error_response(405, req.method + " is not allowed: the dashboard is read-only (GET, HEAD)"));
+  };
+  http.Post(".*", read_only);
+  http.Put(".*", read_only);
+  http.Patch(".*", read_only);
+  http.Delete(".*", read_only);
+  http.Options(".*", read_only);
+  http.set_payload_max_length(64 * 1024);
   // httplib's default also sets SO_REUSEPORT: a second dashboard (or any
   // process of this user) could then bind the same port and take part of the
   // traffic. SO_REUSEADDR alone still allows a restart while old connections
@@ -211,16 +230,13 @@ void DashboardServer::Impl::routes() {
     ::setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
   });
   // A connection holds a server thread from its accept to its close, so no
-  // client may keep one without doing anything: a request must arrive within
-  // kIdleSeconds and its bytes keep coming (a read waits at most that long),
-  // and every connection closes after one response (no idle keep-alive; on
+  // client may keep one without doing anything: its whole request must
+  // arrive within kRequestDeadline of the accept (DeadlineServer: a per-read
+  // timeout alone let a byte every 1.5 s hold a thread for minutes), and
+  // every connection closes after one response (no idle keep-alive; on
   // loopback a new connection costs nothing). Event streams hold a thread
   // each for as long as they last (at most max_streams; more get a 503 and
   // the connection closes); the rest of the pool answers the page and API.
-  http.set_read_timeout(kIdleSeconds, 0);
-  http.set_keep_alive_timeout(kIdleSeconds);
-  http.set_keep_alive_max_count(1);
-  http.set_write_timeout(5, 0);
   const size_t threads = static_cast<size_t>(options.max_streams) + kApiThreads;
   http.new_task_queue = [threads] { return new httplib::ThreadPool(threads); };
 }

@@ -264,6 +264,30 @@ def test_bad_parameters_are_400(dash, query):
     assert status == 400 and body["status"] == 400 and body["error"]
 
 
+@pytest.mark.parametrize("limit", ["0", "-1", "100001", "x"])
+def test_a_bad_limit_names_the_one_allowed_range(dash, limit):
+    """limit=0 said "at least 1" and limit=-1 "from 0 to ...": one message, the range allowed."""
+    for path, top in [("/api/runs/r-mid/verdicts", 100000), ("/api/runs", None)]:
+        status, body = dash.get(f"{path}?limit={limit}")
+        assert status == 400, (path, body)
+        assert re.fullmatch(rf"limit must be an integer from 1 to {top or r'[0-9]+'}, not '{re.escape(limit)}'",
+                            body["error"]), body
+
+
+@pytest.mark.parametrize("method", ["POST", "PUT", "PATCH", "DELETE", "OPTIONS"])
+def test_other_methods_are_405_with_allow(dash, method):
+    for path in ["/api/health", "/api/runs", "/"]:
+        conn = http.client.HTTPConnection("127.0.0.1", dash.port, timeout=10)
+        conn.request(method, path, body=b"{}" if method in ("POST", "PUT", "PATCH") else None,
+                     headers={"Content-Type": "application/json"})
+        r = conn.getresponse()
+        body = json.loads(r.read())
+        conn.close()
+        assert r.status == 405 and r.getheader("Allow") == "GET, HEAD", (method, path, r.status)
+        assert body["status"] == 405 and "read-only" in body["error"]
+    assert dash.get("/api/health")[0] == 200
+
+
 def test_unknown_things_are_404(dash):
     for path in ["/api/runs/nope", "/api/runs/nope/verdicts", "/api/runs/nope/violations", "/api/runs/nope/counters",
                  "/api/runs/r-mid/verdicts?property=nope", "/api/nothing", "/nothing"]:
@@ -731,3 +755,44 @@ def test_api_answers_with_slow_clients_and_streams_over_the_cap(dash):
         for t in slow:
             t.join(timeout=30)
     assert len(closed_by_server) == 20  # every slow client was cut off by the server's read timeout
+
+
+def test_health_answers_while_60_clients_trickle(dash):
+    """60 clients each sending one byte of a request every 1.5 s (more than the server's threads):
+    every connection must deliver its whole request within a deadline, so the tricklers are cut off
+    and /api/health answers while they still trickle (before: 40 of them left it unanswered for ~50 s;
+    each holds a thread ~70 s). Bounded: 60 loopback sockets, each closed within 90 s."""
+    import socket
+
+    stop = threading.Event()
+    cut = []
+
+    def trickle():
+        try:
+            s = socket.create_connection(("127.0.0.1", dash.port), timeout=5)
+        except OSError:
+            return
+        try:
+            for byte in b"GET /api/health HTTP/1.1\r\nHost: 127.0.0.1\r\nX-Padding: aaaaaaaaaaaaaaaaaaaa\r\n\r\n":
+                s.sendall(bytes([byte]))
+                if stop.wait(1.5):
+                    return
+        except OSError:
+            cut.append(True)  # the server closed the connection (reset or broken pipe)
+        finally:
+            s.close()
+
+    slow = [threading.Thread(target=trickle, daemon=True) for _ in range(60)]
+    for t in slow:
+        t.start()
+    try:
+        time.sleep(3)  # every trickler connected and holding its connection
+        conn = http.client.HTTPConnection("127.0.0.1", dash.port, timeout=45)
+        conn.request("GET", "/api/health", headers={"Host": "127.0.0.1"})
+        r = conn.getresponse()
+        assert r.status == 200 and json.loads(r.read())["ok"] is True
+        conn.close()  # within the socket's 45 s: a liveness bound, not a speed (each trickler needs ~90 s)
+    finally:
+        stop.set()
+        for t in slow:
+            t.join(timeout=90)
