@@ -90,9 +90,9 @@ TEST(Rosbag2Zstd, FramesAreToldFromCdrAndCutFramesAreRefused) {
   EXPECT_TRUE(is_zstd_frame(frame));
   EXPECT_FALSE(is_zstd_frame(std::string("\x00\x01\x00\x00", 4)));  // a CDR encapsulation header
   std::string out, error;
-  ASSERT_TRUE(zstd_decompress(frame, out, error)) << error;
+  ASSERT_TRUE(zstd_decompress(frame, out, error, 1 << 20)) << error;
   EXPECT_EQ(out, "hello");
-  EXPECT_FALSE(zstd_decompress(frame.substr(0, 11), out, error));
+  EXPECT_FALSE(zstd_decompress(frame.substr(0, 11), out, error, 1 << 20));
   EXPECT_NE(error.find("cut short"), std::string::npos) << error;
 }
 
