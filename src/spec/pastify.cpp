@@ -91,7 +91,8 @@ struct Sizer {
       case Op::And:
       case Op::Or:
       case Op::Implies: return add(1, add(visit(*n.left, d), visit(*n.right, d)));
-      case Op::Pre:
+      // guard_pre: or + (and + once[d:] + true) + (and + not + once[d:] + true + once + false)
+      case Op::Pre: return add(1 + (d > 0 ? 10 : 0), visit(*n.left, d));
       case Op::Once: return add(1 + started(d), visit(*n.left, d));
       case Op::Historically: return add(1 + not_started(d), visit(*n.left, d));
       case Op::Since: return add(1 + started(d), add(visit(*n.left, d), visit(*n.right, d)));
