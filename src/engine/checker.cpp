@@ -100,6 +100,7 @@ namespace {
 void in_nanoseconds(spec::Node& n) {
   n.bounds.lo = n.bounds.lo_ns;
   n.bounds.hi = n.bounds.hi_ns;
+  n.bounds.in_ns = true;
   if (n.left) in_nanoseconds(*n.left);
   if (n.right) in_nanoseconds(*n.right);
 }

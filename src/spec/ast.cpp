@@ -1,4 +1,5 @@
 #include "spec/ast.hpp"
+#include "spec/exact_time.hpp"
 
 #include <cctype>
 #include <charconv>
@@ -51,9 +52,11 @@ std::string literal_text(const Literal& l) {
 std::string bounds_text(const Bounds& b) {
   if (!b.explicit_bounds) return "";
   std::string out = "[";
-  if (b.lo != 0) out += number_text(b.lo);
+  // Rescaled to nanoseconds (engine::Checker): printed as the seconds written.
+  const auto text = [&](double v) { return b.in_ns ? seconds_text(static_cast<int64_t>(v)) : number_text(v); };
+  if (b.lo != 0) out += text(b.lo);
   out += ":";
-  if (b.hi != kInfinity) out += number_text(b.hi);
+  if (b.hi != kInfinity) out += text(b.hi);
   return out + "]";
 }
 

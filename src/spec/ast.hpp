@@ -26,6 +26,7 @@ struct Bounds {
   // rescales its copy of the formula); lo/hi stay the written seconds.
   double lo_ns = 0;
   double hi_ns = kInfinity;
+  bool in_ns = false;  // lo/hi hold the nanoseconds (the checker's copy): printed as seconds
   bool unbounded() const { return lo == 0 && hi == kInfinity; }
 };
 
