@@ -45,9 +45,11 @@ SqliteRows::Step SqliteRows::step() {
     }
     const int rc = sqlite3_step(st_);
     if (rc == SQLITE_ROW) {
+      // The place to go on from only moves forward: a damaged b-tree may give
+      // row ids out of order, and going back to one would read in circles.
       const int64_t id = sqlite3_column_int64(st_, sqlite3_column_count(st_) - 1);
       if (id == INT64_MAX) at_end_ = true;
-      else next_ = id + 1;
+      else if (id >= next_) next_ = id + 1;
       return Row;
     }
     if (rc == SQLITE_DONE || at_end_) return Done;
