@@ -102,7 +102,7 @@ def main():
         "sample": b"\x05" + z.compress(sample),
         "two_frames": b"\x05" + z.compress(sample) + z.compress(sample * 3),
         "undeclared": b"\x07" + streamed,
-        "skippable": b"\x05" + skippable + z.compress(sample),
+        "then_skippable": b"\x05" + z.compress(sample) + skippable + z.compress(sample),
         "bomb_64mib": b"\x11" + bomb,
         "cut_short": b"\x05" + z.compress(sample * 50)[:-3],
         "checksum": b"\x05" + zstandard.ZstdCompressor(write_checksum=True).compress(sample * 20),

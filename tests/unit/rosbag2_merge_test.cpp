@@ -96,5 +96,27 @@ TEST(Rosbag2Zstd, FramesAreToldFromCdrAndCutFramesAreRefused) {
   EXPECT_NE(error.find("cut short"), std::string::npos) << error;
 }
 
+TEST(Rosbag2Zstd, OutputStopsAtTheCap) {
+  // The same "hello" frame: a cap of 4 bytes refuses it, streamed (no size
+  // declared: stopped at the cap), naming --max-message-size; 5 reads it.
+  const std::string frame("\x28\xb5\x2f\xfd\x00\x58\x29\x00\x00hello", 14);
+  std::string out, error;
+  bool too_large = false;
+  EXPECT_FALSE(zstd_decompress(frame, out, error, 4, &too_large));
+  EXPECT_TRUE(too_large);
+  EXPECT_TRUE(out.empty());
+  EXPECT_NE(error.find("more than the limit of 4 bytes"), std::string::npos) << error;
+  EXPECT_NE(error.find("--max-message-size"), std::string::npos) << error;
+  ASSERT_TRUE(zstd_decompress(frame, out, error, 5, &too_large)) << error;
+  EXPECT_EQ(out, "hello");
+  EXPECT_FALSE(too_large);
+  // A frame whose header declares 1048740 bytes and whose one (last, raw)
+  // block holds none: damaged. zstd's streaming decoder let it through, its
+  // one-shot decoder does not (found by fuzz_zstd).
+  const std::string lying("\x28\xb5\x2f\xfd\x80\x68\xa4\x00\x10\x00\x01\x00\x00", 13);
+  EXPECT_FALSE(zstd_decompress(lying, out, error, 2 << 20));
+  EXPECT_NE(error.find("declares 1048740 bytes decompressed, its blocks hold 0"), std::string::npos) << error;
+}
+
 }  // namespace
 }  // namespace rvc::transport

@@ -155,8 +155,9 @@ bool SqliteBag::read_already(sqlite3_stmt* st) const {
 
 namespace {
 std::string row_span(int64_t from, int64_t to) {
-  if (from == INT64_MIN) return "the rows before row id " + std::to_string(to + 1);
+  if (from == INT64_MIN && to == INT64_MAX) return "all the rows";
   if (to == INT64_MAX) return "the rows from row id " + std::to_string(from) + " on";
+  if (from == INT64_MIN) return "the rows before row id " + std::to_string(to + 1);
   if (from == to) return "row id " + std::to_string(from);
   return "row ids " + std::to_string(from) + "-" + std::to_string(to);
 }

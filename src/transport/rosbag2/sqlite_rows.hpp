@@ -49,7 +49,11 @@ class SqliteRows {
 
   sqlite3* db_;
   std::string columns_;
-  sqlite3_stmt* st_ = nullptr;
+  sqlite3_stmt* st_ = nullptr;     // the scan
+  sqlite3_stmt* probe_ = nullptr;  // one row at rowid >= ?1
+  bool prepared_ = false, open_ = false;
+  int64_t start_ = INT64_MIN;  // where the open statement's search began
+  uint64_t restarts_ = 0, max_restarts_ = uint64_t{1} << 20;
   int64_t next_ = INT64_MIN;  // the first row id not read yet
   int64_t retried_ = INT64_MIN;  // a failure where a fresh search read on: failing there again skips it
   bool retry_armed_ = false;

@@ -21,6 +21,23 @@ bool is_zstd_frame(std::string_view b) {
 }
 
 namespace {
+// What the frames' headers declare they decompress to, summed over the
+// frames (a skippable frame declares 0); ZSTD_CONTENTSIZE_UNKNOWN if a
+// frame does not say, or the frames cannot be told apart.
+unsigned long long declared_size(std::string_view in) {
+  unsigned long long total = 0;
+  for (size_t pos = 0; pos < in.size();) {
+    const size_t frame = ZSTD_findFrameCompressedSize(in.data() + pos, in.size() - pos);
+    const unsigned long long content = ZSTD_getFrameContentSize(in.data() + pos, in.size() - pos);
+    if (ZSTD_isError(frame) || content == ZSTD_CONTENTSIZE_UNKNOWN || content == ZSTD_CONTENTSIZE_ERROR ||
+        total + content < total)
+      return ZSTD_CONTENTSIZE_UNKNOWN;
+    total += content;
+    pos += frame;
+  }
+  return total;
+}
+
 struct DStream {
   ZSTD_DStream* s = ZSTD_createDStream();
   ~DStream() { ZSTD_freeDStream(s); }
@@ -37,16 +54,25 @@ bool zstd_decompress(std::string_view in, std::string& out, std::string& error, 
     error = "zstd: " + what + " (--max-message-size)";
     return false;
   };
-  // A frame that says its size up front is refused before any byte is made.
-  const unsigned long long declared = ZSTD_getFrameContentSize(in.data(), in.size());
-  if (declared != ZSTD_CONTENTSIZE_UNKNOWN && declared != ZSTD_CONTENTSIZE_ERROR) {
-    if (declared > max_out) return over("its frame declares " + std::to_string(declared) + " bytes decompressed, over the limit of " +
-                                            std::to_string(max_out));
+  // Frames that say their size up front are refused before any byte is made.
+  const unsigned long long declared = declared_size(in);
+  if (declared != ZSTD_CONTENTSIZE_UNKNOWN) {
+    if (declared > max_out)
+      return over("its frame declares " + std::to_string(declared) + " bytes decompressed, over the limit of " +
+                  std::to_string(max_out));
     out.reserve(static_cast<size_t>(declared));
   }
-  DStream d;
+  // One decoder and buffer per thread, reset per message: a bag of small
+  // compressed messages allocates nothing per message (a DStream and its
+  // window cost more than most messages).
+  thread_local DStream d;
+  thread_local std::vector<char> buf(ZSTD_DStreamOutSize());
+  if (!d.s) {
+    error = "zstd: out of memory";
+    return false;
+  }
+  ZSTD_DCtx_reset(d.s, ZSTD_reset_session_only);
   ZSTD_inBuffer src{in.data(), in.size(), 0};
-  std::vector<char> buf(ZSTD_DStreamOutSize());
   size_t ret = 0;
   for (;;) {
     ZSTD_outBuffer dst{buf.data(), buf.size(), 0};
@@ -63,6 +89,14 @@ bool zstd_decompress(std::string_view in, std::string& out, std::string& error, 
   }
   if (ret != 0) {
     error = "zstd: the compressed data is cut short after " + std::to_string(in.size()) + " bytes";
+    return false;
+  }
+  // zstd's streaming decoder does not hold a frame to its declared size
+  // (its one-shot decoder does): a frame whose blocks hold less or more is damaged.
+  if (declared != ZSTD_CONTENTSIZE_UNKNOWN && declared != out.size()) {
+    error = "zstd: the frame declares " + std::to_string(declared) + " bytes decompressed, its blocks hold " +
+            std::to_string(out.size()) + " (damaged)";
+    out.clear();
     return false;
   }
   return true;

@@ -18,7 +18,8 @@ bool is_zstd_frame(std::string_view bytes);
 // frame may expand to gigabytes). False with the reason in `error` for data
 // that is not whole or that would decompress to more than `max_out`
 // (`too_large` then set).
-bool zstd_decompress(std::string_view in, std::string& out, std::string& error, size_t max_out, bool* too_large = nullptr);
+bool zstd_decompress(std::string_view in, std::string& out, std::string& error, size_t max_out = size_t{256} << 20,
+                     bool* too_large = nullptr);
 
 // A storage file compressed whole, decompressed to a temporary file that rvc
 // creates (mkstemp in $TMPDIR, else /tmp) and removes when this is destroyed:
