@@ -71,6 +71,11 @@ def write_rosbag2(tmp_path, ts, gears, steers):
     return str(bags[0])
 
 
+def stamp(t):
+    """Integer nanoseconds as a JSON Time object: the exact instant, independent of rvc's decimal reading."""
+    return {"sec": t // 10**9, "nanosec": t % 10**9}
+
+
 def json_trace(tmp_path, name, rows):
     p = tmp_path / name
     p.write_text("".join(json.dumps(r) + "\n" for r in rows))
@@ -97,7 +102,7 @@ def test_rosbag2_bag_checks_like_its_json(rvc, tmp_path, typestore):
     steer_spec = "historically[0:0.3]{steering_tire_angle < 0.5}"
     dense = run([rvc, "check", "--dense", "--spec", steer_spec, bag, "--topic", STEER_TOPIC])
     f32 = lambda a: struct.unpack("<f", struct.pack("<f", a))[0]  # the wire type is float32
-    rows = [{"t": t / 1e9, "steering_tire_angle": f32(a)} for t, a in steers]
+    rows = [{"t": stamp(t), "steering_tire_angle": f32(a)} for t, a in steers]
     want = run([rvc, "check", "--dense", "--time-field", "t", "--spec", steer_spec,
                 json_trace(tmp_path, "steer.jsonl", rows)])
     assert dense.stdout == want.stdout and '"value":false' in want.stdout, dense.stderr
@@ -111,7 +116,7 @@ def test_rosbag2_robustness_like_its_json(rvc, tmp_path, typestore):
     steers = [(t + 7, random.Random(t).uniform(-0.6, 0.6)) for t, _ in gear_values(80, 4)]
     bag = write_rosbag2(tmp_path, typestore, gears, steers)
     f32 = lambda a: struct.unpack("<f", struct.pack("<f", a))[0]  # the wire type is float32
-    steer_rows = [{"t": t / 1e9, "steering_tire_angle": f32(a)} for t, a in steers]
+    steer_rows = [{"t": stamp(t), "steering_tire_angle": f32(a)} for t, a in steers]
     steer_json = json_trace(tmp_path, "steer.jsonl", steer_rows)
 
     def values(out):
@@ -167,7 +172,7 @@ def test_several_topics_of_a_bag_in_one_run(rvc, tmp_path, typestore):
     for t, name, value in sorted([(t, "gear", {"report": r}) for t, r in gears] +
                                  [(t, "steer", {"steering_tire_angle": f32(a)}) for t, a in steers]):
         latest[name] = value
-        events.append(dict(latest, t=(float(t // 10**9) * 1e9 + float(t % 10**9)) / 1e9))
+        events.append(dict(latest, t=stamp(t)))
     trace = json_trace(tmp_path, "merged.jsonl", events)
     topics = ["--topic", f"gear={GEAR_TOPIC}", "--topic", f"steer={STEER_TOPIC}"]
     for mode, spec, numeric in [
@@ -218,7 +223,7 @@ def test_mcap_writer_chunk_compressions(rvc, tmp_path, typestore, compression):
     spec = "{report == REVERSE} -> once[0:0.5]{report == PARK}"
     got = run([rvc, "check", "--dense", "--spec", spec, str(path)])  # one topic: no --topic needed
     want = run([rvc, "check", "--dense", "--time-field", "t", "--spec", "{report == 20} -> once[0:0.5]{report == 22}",
-                json_trace(tmp_path, "g.jsonl", [{"t": t / 1e9, "report": r} for t, r in gears])])
+                json_trace(tmp_path, "g.jsonl", [{"t": stamp(t), "report": r} for t, r in gears])])
     assert got.stdout == want.stdout and '"value":false' in want.stdout, got.stderr
 
 
@@ -317,7 +322,7 @@ def test_data_references_on_typed_samples(rvc, tmp_path, typestore):
     dense_spec = "forall[g]. ({report: *g} -> once[0.05:0.3]{report: *g})"
     got = run([rvc, "check", "--dense", "--spec", dense_spec, bag, "--topic", GEAR_TOPIC])
     want = run([rvc, "check", "--dense", "--time-field", "t", "--spec", dense_spec,
-                json_trace(tmp_path, "gt.jsonl", [{"t": t / 1e9, "report": r} for t, r in gears])])
+                json_trace(tmp_path, "gt.jsonl", [{"t": stamp(t), "report": r} for t, r in gears])])
     assert got.stdout == want.stdout and '"value":false' in want.stdout, got.stderr
     r = run([rvc, "check", "--spec", "exists[s]. {stamp: *s}", bag, "--topic", GEAR_TOPIC])
     assert r.returncode == 2 and "a reference binds a string, number or Boolean field" in r.stderr, r.stderr
