@@ -351,12 +351,13 @@ def test_a_gzip_file_is_refused(rvc, tmp_path):
         assert r.returncode == 2 and f"rvc hz: '{f}' is a gzip file, not JSON lines" in r.stderr, r.stderr
 
 
-def test_stamps_beyond_the_period_s_resolution_still_end(rvc, tmp_path):
-    """At 1e20 s a double resolves 16384 s, far above --period 1: the report boundary still moves
-    (before: boundary + period == boundary, a loop that never ended)."""
+def test_stamps_beyond_exact_time_are_refused_and_the_run_ends(rvc, tmp_path):
+    """1e20 s is past int64 nanoseconds (9223372036.854775807 s): each such stamp is refused by name,
+    counted, and the run ends with nothing checked (exit 6). Before exact time such stamps hung the
+    report schedule (boundary + period == boundary at a double's 16384 s resolution)."""
     f = tmp_path / "far.jsonl"
     f.write_text("".join(json.dumps({"time": t}) + "\n" for t in [1e20, 1e20 + 65536, 1e20 + 131072]))
     r = run(rvc, f"file:{f}", "--time-source", "stamps", "--json", "--timeout", "0", timeout=30)
-    assert r.returncode == 0, r.stderr
-    reports = [json.loads(line)["t"] for line in r.stdout.splitlines()]
-    assert len(reports) <= 4 and reports == sorted(reports) and reports[-1] == 1e20 + 131072
+    assert r.returncode == 6, r.stderr
+    assert r.stderr.count("beyond the range of exact time") == 3, r.stderr
+    assert "received 3 (checked 0, rejected 3)" in r.stderr, r.stderr

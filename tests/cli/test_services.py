@@ -307,10 +307,10 @@ def test_monitor_calls_settles_a_late_request_by_a_later_events_stamp(rvc, tmp_p
                                 event_line(3, 2010, 1, 2, None, {"success": True, "message": ""})]) + "\n")
     r = run([rvc, "monitor", "--input", f"file:{trace}", "--calls", "--service-timeout", "0.2", "--all", "--dense",
              "--spec", "{answered}"], check=1)
-    # dense: false from 0 (the timeline's start) and at call 1; true from call 2; the file's end ticks at the
-    # events' clock, 2.01 (the pipe's check ends at its last call, 2.0)
+    # dense: false at call 1 (the timeline's start: its first call); true from call 2; the file's end
+    # ticks at the events' clock, 2.01 (the pipe's check ends at its last call, 2.0)
     assert [(json.loads(l)["time"], json.loads(l)["value"]) for l in r.stdout.splitlines()] == [
-        (0, False), (1, False), (2, True), (2.01, True)]
+        (1, False), (2, True), (2.01, True)]
 
 
 @pytest.mark.needs_rust

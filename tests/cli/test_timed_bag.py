@@ -55,17 +55,18 @@ def bag(rvc, tmp_path):
 
 
 PROPERTIES = {
+    # (the timeline starts at the first message, imu's at 1.0: --origin first)
     # silence: imu's last message before the gap is at 2.0, so false from 2.0 + 0.125 until 2.5
-    "silence": ("{imu.@age <= 0.125}", [(0, False), (1.0, True), (2.125, False), (2.5, True)]),
+    "silence": ("{imu.@age <= 0.125}", [(1.0, True), (2.125, False), (2.5, True)]),
     # rate: at least 4 imu messages in the last 0.5 s (the window (t-0.5, t]); the fourth-last before
     # the gap (1.8125) leaves at 2.3125; after it the fourth message is at 2.6875
-    "rate": ("{count[0:0.5](imu.@arrived) >= 4}", [(0, False), (1.1875, True), (2.3125, False), (2.6875, True)]),
+    "rate": ("{count[0:0.5](imu.@arrived) >= 4}", [(1.0, False), (1.1875, True), (2.3125, False), (2.6875, True)]),
     # latency: arrival (log time) - stamp is 1/64 s, then 0.25 s from 2.5 on; unknown before any message
-    "latency": ("{imu.@latency < 0.125}", [(0, False), (1.0, True), (2.5, False)]),
+    "latency": ("{imu.@latency < 0.125}", [(1.0, True), (2.5, False)]),
     # a typed field's window: imu's angle (0.1) has a sample in (t-0.25, t] except from 2.0 + 0.25 to 2.5
-    "angle": ("{min[0:0.25](imu.steering_tire_angle) > 0.05}", [(0, False), (1.0, True), (2.25, False), (2.5, True)]),
+    "angle": ("{min[0:0.25](imu.steering_tire_angle) > 0.05}", [(1.0, True), (2.25, False), (2.5, True)]),
     # the steady topic never falls silent for 0.125 s: one verdict, true from its first message
-    "gear": ("{gear.@age <= 0.125}", [(0, False), (1.03125, True)]),
+    "gear": ("{gear.@age <= 0.125}", [(1.0, False), (1.03125, True)]),
 }
 
 
