@@ -45,15 +45,14 @@ def test_bag_end_tick_reports_a_fall_after_the_topics_last_message(rvc, tmp_path
     args = [rvc, "check", "--dense", "--topic", GEAR_TOPIC, "--spec", "once[0:0.5]{report == 2}",
             "--spec", "once[0:5]{report == 2}", bag]
     got = run(args)
-    assert got.returncode == 1, got.stderr  # false on [0, 0.25) already: the timeline starts at 0
+    assert got.returncode == 1, got.stderr  # p1 falls at 1.5 (the timeline starts at the first message, 0.25)
     # By hand: report 2 holds over [0.25, 1.0); once[0:0.5] falls at 1.0 + 0.5 = 1.5, after the last
     # gear message (1.0) and before the recording's end (stamp 1.0 + 2 s of log time = 3.0).
     # once[0:5] would fall at 6.0, after the recording: not reported.
-    assert verdicts(got.stdout) == [("p1", 0, False), ("p2", 0, False), ("p1", 0.25, True), ("p2", 0.25, True),
-                                    ("p1", 1.5, False)]
+    assert verdicts(got.stdout) == [("p1", 0.25, True), ("p2", 0.25, True), ("p1", 1.5, False)]
     off = run(args[:2] + ["--clock", "off"] + args[2:])
     # Without the tick the fall is never seen.
-    assert verdicts(off.stdout) == [("p1", 0, False), ("p2", 0, False), ("p1", 0.25, True), ("p2", 0.25, True)]
+    assert verdicts(off.stdout) == [("p1", 0.25, True), ("p2", 0.25, True)]
 
 
 @pytest.mark.needs_rust  # the MCAP reader is in the Rust library
@@ -68,10 +67,10 @@ def test_json_trace_end_tick_reports_the_last_messages_value(rvc, tmp_path):
     trace = tmp_path / "t.jsonl"
     trace.write_text('{"time": 1, "p": true}\n{"time": 2, "p": false}\n')
     got = run([rvc, "check", "--dense", "--spec", "{p}", str(trace)])
-    # [0, 1): p unseen (false); [1, 2): true; at 2, the last message's own value: false.
-    assert verdicts(got.stdout) == [("p1", 0, False), ("p1", 1, True), ("p1", 2, False)], got.stderr
+    # From the first message at 1 (the timeline's start): [1, 2) true; at 2, the last message's own value: false.
+    assert verdicts(got.stdout) == [("p1", 1, True), ("p1", 2, False)], got.stderr
     off = run([rvc, "check", "--dense", "--clock", "off", "--spec", "{p}", str(trace)])
-    assert verdicts(off.stdout) == [("p1", 0, False), ("p1", 1, True)]
+    assert verdicts(off.stdout) == [("p1", 1, True)]
     # Discrete time has no clock: --clock changes nothing there.
     disc = run([rvc, "check", "--spec", "{p}", str(trace)])
     assert verdicts(disc.stdout) == [("p1", 0, True), ("p1", 1, False)]

@@ -19,10 +19,12 @@ def write_topic(path, n, start, period, seed, stamp=True):
     rnd = random.Random(seed)
     rows, t = [], start
     for _ in range(n):
-        t += period + rnd.uniform(-period / 10, period / 10)
+        # Stamps with at most 9 decimals, as real ones have: rvc reads them to the nanosecond, exactly
+        # the double Python reads (longer random floats would be rounded to the nanosecond first).
+        t = round(t + period + rnd.uniform(-period / 10, period / 10), 9)
         row = {"time": t}
         if stamp:
-            row["stamp"] = t - rnd.uniform(0.001, 0.05)
+            row["stamp"] = round(t - rnd.uniform(0.001, 0.05), 9)
         rows.append(row)
     path.write_text("".join(json.dumps(r) + "\n" for r in rows))
     return rows
