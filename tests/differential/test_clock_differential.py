@@ -133,7 +133,7 @@ def test_ticks_equal_heartbeat_messages_in_rvc(rvc, driver, tmp_path, seed):
     write_jsonl(tr, merged(events, ticks, lambda t: {"time": t}))
     # --clock off: no tick at the trace's end (it would add the last message's own value, which the
     # driver, ticking only between messages, does not report; test_check_ticks_at_the_end covers it).
-    proc = subprocess.run([rvc, "check", "--dense", "--clock", "off", "--properties", str(props), str(tr)],
+    proc = subprocess.run([rvc, "check", "--dense", "--origin", "zero", "--clock", "off", "--properties", str(props), str(tr)],
                           capture_output=True, text=True)
     assert proc.returncode in (0, 1), proc.stderr
     beats = {f"f{i}": [] for i in range(len(formulas))}

@@ -137,7 +137,7 @@ def rvc_sets(rvc, tmp_path, formulas, events):
     props.write_text(json.dumps({"properties": [{"name": f"f{i}", "spec": text(f)} for i, f in enumerate(formulas)]}))
     tr = tmp_path / "trace.jsonl"
     tr.write_text("".join(json.dumps(e) + "\n" for e in events))
-    proc = subprocess.run([rvc, "check", "--dense", "--clock", "off", "--properties", str(props), str(tr)],
+    proc = subprocess.run([rvc, "check", "--dense", "--origin", "zero", "--clock", "off", "--properties", str(props), str(tr)],
                           capture_output=True, text=True)
     assert proc.returncode in (0, 1), proc.stderr
     T = events[-1]["time"]
@@ -239,7 +239,7 @@ def test_dense_robustness_matches_grid_oracle(rvc, tmp_path, seed):
     props.write_text(json.dumps({"properties": [{"name": f"f{i}", "spec": text(f)} for i, f in enumerate(formulas)]}))
     tr = tmp_path / "trace.jsonl"
     tr.write_text("".join(json.dumps(e) + "\n" for e in events))
-    proc = subprocess.run([rvc, "check", "--dense", "--robustness", "--clock", "off", "--properties", str(props),
+    proc = subprocess.run([rvc, "check", "--dense", "--origin", "zero", "--robustness", "--clock", "off", "--properties", str(props),
                            str(tr)], capture_output=True, text=True)
     assert proc.returncode in (0, 1), proc.stderr
     changes = {f"f{i}": [] for i in range(len(formulas))}

@@ -78,9 +78,9 @@ MODES = {
     "discrete-all": ["--all"],
     "discrete-explain": ["--explain"],
     "discrete-robustness": ["--robustness"],
-    "dense": ["--dense"],
-    "dense-explain": ["--dense", "--explain"],
-    "dense-robustness": ["--dense", "--robustness"],
+    "dense": ["--dense", "--origin", "zero"],
+    "dense-explain": ["--dense", "--origin", "zero", "--explain"],
+    "dense-robustness": ["--dense", "--origin", "zero", "--robustness"],
 }
 
 

@@ -26,7 +26,7 @@ def run_rvc(rvc, tmp_path, formulas, events, dense):
     tr = tmp_path / "trace.jsonl"
     write_jsonl(tr, events)
     args = [rvc, "check", "--properties", str(props), str(tr)]
-    args += ["--dense"] if dense else ["--all"]
+    args += ["--dense", "--origin", "zero"] if dense else ["--all"]
 
     def verdicts(extra):
         proc = subprocess.run(args + extra, capture_output=True, text=True)

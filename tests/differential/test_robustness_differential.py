@@ -94,7 +94,7 @@ def run_rvc(rvc, tmp_path, formulas, events, dense=False):
     write_jsonl(tr, events)
     # --clock off: no tick at the trace's end (it adds the last message's own value, which Reelay
     # does not report; test_reelay_differential checks the tick changes nothing else).
-    proc = subprocess.run([rvc, "check", "--robustness", "--dense" if dense else "--all", "--clock", "off",
+    proc = subprocess.run([rvc, "check", "--robustness", *(["--dense", "--origin", "zero"] if dense else ["--all"]), "--clock", "off",
                            "--properties", str(props), str(tr)],
                           capture_output=True, text=True)
     assert proc.returncode in (0, 1), f"rvc failed ({proc.returncode}): {proc.stderr}"

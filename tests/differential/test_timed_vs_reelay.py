@@ -132,7 +132,7 @@ def run_rvc(rvc, tmp_path, formulas, events, dense):
     tr.write_text("".join(json.dumps(e) + "\n" for e in events))
     # --clock off: Reelay tells nothing at the last message's own instant, which the end-of-input
     # tick adds (the clock tests compare that tick with heartbeats instead).
-    args = [rvc, "check", "--properties", str(props), str(tr)] + (["--dense", "--clock", "off"] if dense else ["--all"])
+    args = [rvc, "check", "--properties", str(props), str(tr)] + (["--dense", "--origin", "zero", "--clock", "off"] if dense else ["--all"])
     proc = subprocess.run(args, capture_output=True, text=True)
     assert proc.returncode in (0, 1), f"rvc failed ({proc.returncode}): {proc.stderr}"
     out = {f"f{i}": [] for i in range(len(formulas))}

@@ -42,7 +42,7 @@ def rvc_check(rvc, tmp_path, spec, events, dense):
     path = tmp_path / "trace.jsonl"
     path.write_text("".join(json.dumps(e) + "\n" for e in events))
     # Dense: --clock off, no tick at the trace's end (Reelay reports nothing for the last message's instant).
-    args = [rvc, "check", "--spec", spec, str(path)] + (["--dense", "--clock", "off"] if dense else ["--all"])
+    args = [rvc, "check", "--spec", spec, str(path)] + (["--dense", "--origin", "zero", "--clock", "off"] if dense else ["--all"])
     proc = subprocess.run(args, capture_output=True, text=True)
     assert proc.returncode in (0, 1), proc.stderr
     return [(json.loads(l)["time"], json.loads(l)["value"]) for l in proc.stdout.splitlines()]
