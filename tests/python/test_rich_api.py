@@ -2,6 +2,7 @@
 typed ROS 2 messages from CDR bytes, bags. Oracles: Reelay's package (each property alone,
 update by update), rosbags (the CDR bytes and the bags), numpy's own rows, hand-computed values."""
 import json
+import os
 import math
 import random
 import warnings
@@ -207,3 +208,17 @@ def test_camera_frames_and_the_size_cap(humble, tmp_path):
     assert (r.received, r.checked, r.rejected, r.exit_code) == (3, 3, 0, 0)
     r = rvc.check_bag(tmp_path / "camera", spec, max_message_size=1_000_000)
     assert (r.received, r.checked, r.rejected) == (3, 0, 3) and f"a sample of {len(cdr)} bytes" in r.errors[0]
+
+
+AUTOWARE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "..", "shared", "data", "autoware-bags",
+                        "bag_ego_trajectory_turn-right.db3")
+
+
+def test_check_bag_on_a_real_autoware_recording_holds_from_its_first_stamp():
+    # Epoch-stamped nav_msgs/Odometry (issue 36): a dense property that holds is reported as holding,
+    # at the first message's stamp (rosbags' reading of it: 1703219718.026702445 s), not violated at 0.
+    assert os.path.exists(AUTOWARE), f"{AUTOWARE}: the shared Autoware recording is this test's data"
+    r = rvc.check_bag(AUTOWARE, {"sane": "historically({twist.twist.linear.x < 1000})"}, dense=True)
+    assert (r.checked, r.rejected, r.exit_code) == (2819, 0, 0), r.errors
+    assert [(v.time, v.value) for v in r.verdicts] == [(1703219718.026702445, True)]
+    assert not r.violated
