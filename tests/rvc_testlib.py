@@ -101,3 +101,18 @@ def dds_matched(entity) -> int:
     if hasattr(entity, "get_publication_matched_status"):
         return int(entity.get_publication_matched_status().current_count)
     return int(entity.get_subscription_matched_status().current_count)
+
+
+def write_mcap_bag(path, topic, type_name, schema_text, samples):
+    """One topic of CDR samples (bytes) in an MCAP file, as a ROS 2 recorder writes it, with the
+    `mcap` package as the independent writer; log times 0, 1, 2, ... ns."""
+    from mcap.writer import Writer
+    with open(path, "wb") as f:
+        w = Writer(f)
+        w.start(profile="ros2", library="rvc tests")
+        sid = w.register_schema(name=type_name, encoding="ros2msg", data=schema_text.encode())
+        cid = w.register_channel(topic=topic, message_encoding="cdr", schema_id=sid)
+        for k, data in enumerate(samples):
+            w.add_message(channel_id=cid, log_time=k, publish_time=k, sequence=k, data=bytes(data))
+        w.finish()
+    return str(path)

@@ -12,6 +12,8 @@ import pytest
 
 from conftest import transports_built
 
+from rvc_testlib import write_mcap_bag as write_bag  # noqa: E402
+
 ROWS = [
     {"time": 0.0, "ranges": [0.5, 0.3], "objects": [{"distance": 1}, {"distance": 3}]},
     {"time": 0.5, "ranges": [0.1, 0.3], "objects": []},
@@ -115,19 +117,6 @@ def test_spec_errors_point_at_the_column(rvc):
         r = subprocess.run([rvc, "check", "--spec", spec, "-"], input="", capture_output=True, text=True, timeout=60)
         assert r.returncode == 2, (spec, r.stderr)
         assert words in r.stderr and caret_column(r.stderr) == column, (spec, r.stderr)
-
-
-def write_bag(path, topic, type_name, schema_text, samples):
-    from mcap.writer import Writer
-    with open(path, "wb") as f:
-        w = Writer(f)
-        w.start(profile="ros2", library="rvc tests")
-        sid = w.register_schema(name=type_name, encoding="ros2msg", data=schema_text.encode())
-        cid = w.register_channel(topic=topic, message_encoding="cdr", schema_id=sid)
-        for k, data in enumerate(samples):
-            w.add_message(channel_id=cid, log_time=k, publish_time=k, sequence=k, data=bytes(data))
-        w.finish()
-    return str(path)
 
 
 def bag_values(rvc, bag, spec, *extra):

@@ -13,6 +13,8 @@ import pytest
 
 from conftest import transports_built
 
+from rvc_testlib import write_mcap_bag as write_bag  # noqa: E402
+
 INF = math.inf
 
 
@@ -63,19 +65,6 @@ def test_json_array_quantifier_with_a_nan_element(rvc, tmp_path):
         r_status, r_got = check(rvc, trace, spec, "--all", "--robustness")
         assert r_got == pytest.approx(margins, abs=1e-12), spec
         assert r_status == status == 1, spec
-
-
-def write_bag(path, topic, type_name, schema_text, samples):
-    from mcap.writer import Writer
-    with open(path, "wb") as f:
-        w = Writer(f)
-        w.start(profile="ros2", library="rvc tests")
-        sid = w.register_schema(name=type_name, encoding="ros2msg", data=schema_text.encode())
-        cid = w.register_channel(topic=topic, message_encoding="cdr", schema_id=sid)
-        for k, data in enumerate(samples):
-            w.add_message(channel_id=cid, log_time=k, publish_time=k, sequence=k, data=bytes(data))
-        w.finish()
-    return str(path)
 
 
 @pytest.mark.needs_rust

@@ -22,6 +22,7 @@
 #include <simdjson.h>
 
 #include "io/service_calls.hpp"
+#include "lines.hpp"
 #include "resource_limits.hpp"
 
 extern "C" int LLVMFuzzerInitialize(int* argc, char*** argv) {
@@ -53,22 +54,18 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     ++emitted;
   });
   std::string error;
-  for (size_t start = 0; start < text.size();) {
-    size_t end = text.find('\n', start);
-    if (end == std::string_view::npos) end = text.size();
-    const std::string_view line = text.substr(start, end - start);
-    start = end + 1;
+  rvc::fuzz::for_each_line(text, [&](std::string_view line) {
     if (!line.empty() && line[0] == '@') {  // the clock moves: calls due by then are made
       const std::string number(line.substr(1));
       char* rest = nullptr;
       const double now = std::strtod(number.c_str(), &rest);
       calls.advance(now);
       if (!due_later(calls)) __builtin_trap();
-      continue;
+      return;
     }
     calls.feed(line, error);
     if (!due_later(calls)) __builtin_trap();
-  }
+  });
   const rvc::io::ServiceCallCounts& c = calls.counts();
   if (c.events != c.requests + c.responses + c.duplicates + c.orphans + c.rejected) __builtin_trap();
   calls.finish();

@@ -21,6 +21,7 @@
 #include <string>
 #include <string_view>
 
+#include "lines.hpp"
 #include "resource_limits.hpp"
 #include "runtime/time_field_reader.hpp"
 #include "runtime/topic_rate.hpp"
@@ -61,17 +62,13 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   uint64_t lines = 0, refused = 0;
   double last_report = -INFINITY;
   std::string error;
-  for (size_t start = 0; start < text.size();) {
-    size_t end = text.find('\n', start);
-    if (end == std::string_view::npos) end = text.size();
-    const std::string_view line = text.substr(start, end - start);
-    start = end + 1;
+  rvc::fuzz::for_each_line(text, [&](std::string_view line) {
     ++lines;
     double time = 0;
     if (reader.read(line, time, error) != rvc::runtime::TimeFieldReader::Result::Ok ||
         (stats.any() && time < stats.last_arrival())) {
       ++refused;
-      continue;
+      return;
     }
     const auto& due = schedule.step(time);
     if (due.reports.size() > rvc::runtime::StampSchedule::kMaxCatchUp) __builtin_trap();
@@ -84,7 +81,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       (void)stats.state(boundary);
     }
     stats.add(time, std::nullopt);
-  }
+  });
   if (stats.received() + refused != lines) __builtin_trap();
   return 0;
 }
