@@ -77,7 +77,11 @@ class Session {
   const SessionOptions& options() const { return options_; }
   uint64_t messages() const { return position_; }  // given, refused ones included
   uint64_t rejected() const { return pipeline_->stats().rejected + refused_; }
-  double clock() const { return pipeline_->checker().clock(); }
+  // Dense time: where the monitors are, in seconds (the checker counts nanoseconds from the origin).
+  double clock() const {
+    const double c = pipeline_->checker().clock();
+    return pipeline_->engine_time().started() ? pipeline_->engine_time().seconds(c) : c;
+  }
   bool has_data_references() const { return pipeline_->checker().has_data_references(); }
 
  private:

@@ -77,9 +77,15 @@ def test_bad_message_in_a_batch_costs_only_itself():
     assert [str(w.message) for w in caught] == [
         "message 2: time 0.5 is not after the previous message's time 1 (dense time needs strictly increasing times)"
         " (message skipped)"]
-    # [0,1): x unset, false; [1,2): 5 > 1; from 2: 0
-    assert [(v.index, v.time, v.value) for v in out] == [(0, 0.0, False), (2, 1.0, True), (3, 2.0, False)]
-    assert m.stats == {"messages": 4, "checked": 3, "rejected": 1, "warnings": 0, "violations": 2}
+    # The timeline starts at the first message (origin="first"): [1,2): 5 > 1; from 2: 0
+    assert [(v.index, v.time, v.value) for v in out] == [(2, 1.0, True), (3, 2.0, False)]
+    assert m.stats == {"messages": 4, "checked": 3, "rejected": 1, "warnings": 0, "violations": 1}
+    # origin="zero" (Reelay's rule): [0,1) has x unset, false
+    z = rvc.Monitor({"a": "{x > 1}"}, dense=True, origin="zero")
+    out = z.update_many([{"time": 1, "x": 5}, {"time": 2, "x": 0}, {"time": 3}])
+    assert [(v.index, v.time, v.value) for v in out] == [(0, 0.0, False), (1, 1.0, True), (2, 2.0, False)]
+    with pytest.raises(ValueError, match="origin must be"):
+        rvc.Monitor("{x}", dense=True, origin="last")
 
 
 def test_value_json_cannot_hold_costs_only_its_message():

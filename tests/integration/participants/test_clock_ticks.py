@@ -142,7 +142,8 @@ def play(publish, collected, wait=True):
 
 
 def monitor_args(props_path, clock):
-    return ["monitor", "--dense", "--clock", clock, "--properties", str(props_path)]
+    # --origin zero: the oracle is Reelay, whose timeline starts at 0
+    return ["monitor", "--dense", "--origin", "zero", "--clock", clock, "--properties", str(props_path)]
 
 
 def write_properties(tmp_path):
