@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <limits>
 #include <memory>
 
 #include "cli/check_options.hpp"
@@ -159,7 +160,7 @@ struct CheckCommand {
     }
     if (results)
       results->finish(outcome, stopped ? "signal" : "end of input",
-                      counters_json(pipeline.stats(), pipeline.violations()));
+                      counters_json(pipeline.stats(), pipeline.violations(), pipeline.last_stamp()));
     return outcome.exit_code();
   }
 
@@ -204,7 +205,7 @@ struct CheckCommand {
       std::fprintf(stderr, "%s\n", counters.str().c_str());
     }
     if (results)
-      results->finish(outcome, stopped ? "signal" : "end of input", counters_json(feed.stats(), feed.violations()));
+      results->finish(outcome, stopped ? "signal" : "end of input", counters_json(feed.stats(), feed.violations(), feed.last_stamp()));
     return outcome.exit_code();
   }
 
@@ -239,13 +240,14 @@ struct CheckCommand {
   }
 
   // The run's counters for the results store.
-  static std::string counters_json(const runtime::PipelineStats& s, uint64_t violations) {
-    return io::JsonObject()
-        .add("checked", s.accepted)
-        .add("rejected", s.rejected)
-        .add("warnings", s.warnings)
-        .add("violations", violations)
-        .str();
+  // `stream_time`: dense time's last stamp (NaN: none, or discrete time), so the dashboard's
+  // timeline reaches the last instant checked.
+  static std::string counters_json(const runtime::PipelineStats& s, uint64_t violations,
+                                   double stream_time = std::numeric_limits<double>::quiet_NaN()) {
+    io::JsonObject out;
+    out.add("checked", s.accepted).add("rejected", s.rejected).add("warnings", s.warnings).add("violations", violations);
+    if (stream_time == stream_time) out.add("stream_time", stream_time);
+    return out.str();
   }
 
   void report(const runtime::PipelineStats& s, uint64_t violations) const {

@@ -44,6 +44,8 @@ void add_run_counters(io::JsonObject& out, const Feed& feed, uint64_t verdicts) 
       .add("warnings", s.warnings)
       .add("verdicts", verdicts)
       .add("violations", feed.violations());
+  // Dense time: the last message's stamp (the dashboard's timeline reaches it).
+  if (const double t = feed.last_stamp(); t == t) out.add("stream_time", t);
 }
 
 Outcome check_stream(int fd, Pipeline& pipeline, VerdictOutputs& outputs, io::ReaderOptions reader, bool live,

@@ -115,6 +115,8 @@ std::string MonitorLoop::stats_json() const {
       .add("violations", feed_.violations())
       .add("eos", eos_)
       .add("handoff", handoff());
+  // Dense time: the last message's stamp (the dashboard's timeline reaches it).
+  if (const double t = feed_.last_stamp(); t == t) out.add("stream_time", t);
   if (!options_.input_names.empty()) {
     io::JsonArray inputs;
     for (size_t i = 0; i < counters_.size(); ++i) {

@@ -67,8 +67,9 @@ const snapshot = (run, wall, c) => ['INSERT INTO counters (run, wall, counters) 
 
 function buildDatabase(db) {
   const s = [...SCHEMA];
-  const run = (id, command, inputs, model, started, ended, exit, reason) =>
-    s.push(['INSERT INTO runs VALUES (?,?,?,?,?,?,?,?,?)', [id, command, JSON.stringify(inputs), model, started, ended, exit, reason, null]]);
+  const run = (id, command, inputs, model, started, ended, exit, reason, counters = null) =>
+    s.push(['INSERT INTO runs VALUES (?,?,?,?,?,?,?,?,?)', [id, command, JSON.stringify(inputs), model, started, ended, exit, reason,
+                                                          counters && JSON.stringify(counters)]]);
   const props = (id, names) => names.forEach((n) => s.push(['INSERT INTO properties VALUES (?,?,?)', [id, n, SPECS[n]]]));
 
   // An earlier drive: everything held.
@@ -77,7 +78,8 @@ function buildDatabase(db) {
   for (const p of ['hazard_on_emergency', 'speed_limit', 'gear_park_before_off']) s.push(verdict(DRIVE, p, 0, true, now - 7199));
 
   // A scenario where the hazard lights come on too late.
-  run(HAZARD_LATE, 'rvc check -p autoware.yaml --output sqlite:results.db fault-hazard-late.jsonl', ['fault-hazard-late.jsonl'], 'discrete', now - 3600, now - 3590, 1, 'end of input');
+  run(HAZARD_LATE, 'rvc check -p autoware.yaml --output sqlite:results.db fault-hazard-late.jsonl', ['fault-hazard-late.jsonl'], 'discrete', now - 3600, now - 3590, 1, 'end of input',
+      { input: 'fault-hazard-late.jsonl', received: 200000, checked: 200000, rejected: 0, dropped: {}, verdicts: 4, violations: 1 });
   props(HAZARD_LATE, ['hazard_on_emergency', 'speed_limit', 'gear_park_before_off']);
   s.push(verdict(HAZARD_LATE, 'hazard_on_emergency', 0, true, now - 3599), verdict(HAZARD_LATE, 'speed_limit', 0, true, now - 3599),
          verdict(HAZARD_LATE, 'gear_park_before_off', 0, true, now - 3599), verdict(HAZARD_LATE, 'hazard_on_emergency', 42, false, now - 3595));
@@ -262,6 +264,8 @@ test('choosing another run shows its properties and violations', async () => {
   await page.locator('#violations li[data-violation-id] .violation-head').click();
   assert.equal(await page.locator('#violations .witness-line').count(), 5);
   assert.match(await page.locator('#run-info').innerText(), /fault-hazard-late\.jsonl/);
+  // The timeline reaches the last checked step (200,000 steps: 199999), not the last change (42).
+  assert.match(await page.locator('#axis .axis-range').innerText(), /step 0[\s\S]*step 199999/);
   assert.match(page.url(), new RegExp(`#run=${HAZARD_LATE}$`));
 });
 

@@ -179,3 +179,18 @@ def test_random_nanosecond_traces_match_the_exact_oracle(rvc, tmp_path, seed):
         r = run([rvc, "check", "--dense", "--spec", spec, trace])
         assert r.returncode in (0, 1), r.stderr
         assert verdicts(r.stdout) == want, (spec, msgs, r.stdout)
+
+
+def test_the_results_store_records_where_the_stream_ended(rvc, tmp_path):
+    # The dashboard's timeline reaches the last instant checked, not the last verdict change: the run's
+    # counters carry stream_time (dense), read back here with Python's sqlite3.
+    import sqlite3
+    trace = tmp_path / "t.jsonl"
+    trace.write_text('{"time": 1.5, "p": true}\n{"time": 7.25, "p": true}\n')
+    for args in (["check", "--dense", "--spec", "{p}", str(trace), "-o"],
+                 ["monitor", "--dense", "--spec", "{p}", "--input", f"file:{trace}", "--output"]):
+        db = tmp_path / (args[0] + ".db")
+        r = run([rvc, *args, f"sqlite:{db}"])
+        assert r.returncode == 0, r.stderr
+        (counters,), = sqlite3.connect(db).execute("SELECT counters FROM runs").fetchall()
+        assert json.loads(counters)["stream_time"] == 7.25, counters
