@@ -116,3 +116,16 @@ def write_mcap_bag(path, topic, type_name, schema_text, samples):
             w.add_message(channel_id=cid, log_time=k, publish_time=k, sequence=k, data=bytes(data))
         w.finish()
     return str(path)
+
+
+def memory_capped(mib: int) -> dict:
+    """subprocess.run keywords that cap a child rvc's memory at `mib` MiB, so an over-allocation fails
+    the run: an address-space limit (RLIMIT_AS), or, for an AddressSanitizer build (whose shadow memory
+    needs terabytes of address space), ASan's own caps on resident memory and on one allocation."""
+    asan = os.environ.get("ASAN_OPTIONS")
+    if asan is not None:
+        env = dict(os.environ, ASAN_OPTIONS=f"{asan}:hard_rss_limit_mb={mib}:max_allocation_size_mb={mib}")
+        return {"env": env}
+    import resource
+    limit = mib << 20
+    return {"preexec_fn": lambda: resource.setrlimit(resource.RLIMIT_AS, (limit, limit))}

@@ -4,21 +4,18 @@ need and the limit, within a small address-space cap; the widest inner until und
 runs and gives the hand-computed verdict. Before: two levels took ~90 s and 2.2 GB (under this cap:
 std::bad_alloc, exit 5), three ended in std::bad_alloc."""
 import re
-import resource
 import subprocess
 
 import pytest
 
-CAP = 1 << 30  # 1 GiB of address space: far above what a refusal or a 65,000-node property needs
+from rvc_testlib import memory_capped
 
-
-def cap_memory():
-    resource.setrlimit(resource.RLIMIT_AS, (CAP, CAP))
+CAP_MIB = 1024  # far above what a refusal or a 65,000-node property needs
 
 
 def run(rvc, spec, trace):
     return subprocess.run([rvc, "check", "--spec", spec, "-"], input=trace, capture_output=True, text=True,
-                          timeout=120, preexec_fn=cap_memory)
+                          timeout=120, **memory_capped(CAP_MIB))
 
 
 def error_column(stderr):

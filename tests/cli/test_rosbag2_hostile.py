@@ -206,11 +206,9 @@ def zstd_bomb(size, declare):
 
 
 def run_capped(args, mib=1024):
-    """rvc under an address-space limit: an allocation of the decompressed size fails the run."""
-    import resource
-    limit = mib << 20
-    return subprocess.run(args, capture_output=True, text=True, errors="replace", timeout=300,
-                          preexec_fn=lambda: resource.setrlimit(resource.RLIMIT_AS, (limit, limit)))
+    """rvc under a memory cap (rvc_testlib.memory_capped): an allocation of the decompressed size fails the run."""
+    from rvc_testlib import memory_capped
+    return subprocess.run(args, capture_output=True, text=True, errors="replace", timeout=300, **memory_capped(mib))
 
 
 BOMB = 1536 << 20  # 1.5 GiB of zeros, as in the issue
