@@ -4,7 +4,7 @@ on the 30 Timescales files (10 families x bounds 10/100/1000), in discrete time 
 generated) and in dense time (the same files with an epoch stamp 25 ms apart on every line, written as
 decimal seconds: the path that now reads times exactly).
 
-  python3 bench/exact_time_bench.py --before OLD_RVC [--after build/release/rvc] [--steps 200000] [--reps 3]
+  python3 bench/exact_time_bench.py --before OLD_RVC [--after build/release/rvc] [--steps 1000000] [--reps 5]
 
 OLD_RVC is an rvc built from a commit before exact time (e.g. fdbae9f: `git worktree add /tmp/old
 fdbae9f && cd /tmp/old && bash scripts/build.sh`). The two binaries run interleaved on each file (best
@@ -18,6 +18,7 @@ import csv
 import math
 import os
 import platform
+import re
 import subprocess
 import sys
 import time
@@ -35,6 +36,30 @@ def sec_text(ns):
     return str(whole) if frac == 0 else f"{whole}.{frac:09d}".rstrip("0")
 
 
+def instructions(cmd):
+    err = subprocess.run(["valgrind", "--tool=callgrind", "--callgrind-out-file=/dev/null"] + cmd,
+                         capture_output=True, text=True).stderr
+    return int(re.search(r"Collected : (\d+)", err).group(1))
+
+
+def head(src, dst, n):
+    with open(src) as f, open(dst, "w") as out:
+        for k, line in enumerate(f):
+            if k == n:
+                break
+            out.write(line)
+
+
+def per_line(binary, flags, path, spec, a, b, tmp):
+    """Instructions per line (callgrind: the same count however busy the machine), from the first a and
+    b lines of `path`: the difference cancels start-up."""
+    counts = []
+    for n in (a, b):
+        head(path, tmp, n)
+        counts.append(instructions([binary, "check", *flags, tmp, "--spec", spec]))
+    return (counts[1] - counts[0]) / (b - a)
+
+
 def run_time(cmd):
     t0 = time.perf_counter()
     p = subprocess.run(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
@@ -45,12 +70,15 @@ def run_time(cmd):
 
 
 def dense_copy(src, dst):
-    """Each line with "time" first: an epoch stamp 25 ms after the previous one, as decimal seconds."""
+    """Each line's "time" (its step) replaced by an epoch stamp 25 ms after the previous line's, as
+    decimal seconds (the files carry {"time": step, ...} first)."""
     with open(src) as f, open(dst, "w") as out:
         for k, line in enumerate(f):
-            body = line.strip()[1:]
-            sep = "" if body == "}" else ", "
-            out.write('{"time": ' + sec_text(EPOCH_NS + k * STEP_NS) + sep + body + "\n")
+            line = line.strip()
+            m = re.match(r'\{"time":\s*\d+\s*,?', line)
+            body = line[m.end():] if m else line[1:]
+            sep = "" if body.startswith("}") else ","
+            out.write('{"time":' + sec_text(EPOCH_NS + k * STEP_NS) + sep + body + "\n")
 
 
 def dense_spec(spec, step_s=STEP_NS / 1e9):
@@ -73,9 +101,11 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--before", required=True, help="rvc built before exact time")
     ap.add_argument("--after", default=os.path.join(ROOT, "build", "release", "rvc"))
-    ap.add_argument("--steps", type=int, default=200_000)
-    ap.add_argument("--reps", type=int, default=3)
+    ap.add_argument("--steps", type=int, default=1_000_000)
+    ap.add_argument("--reps", type=int, default=5)
     ap.add_argument("--no-docs", action="store_true")
+    ap.add_argument("--instr-lines", default="20000,60000",
+                    help="A,B: instructions per line from the first A and B lines (callgrind); 0: no count")
     args = ap.parse_args()
     outdir = os.path.join(ROOT, "bench", "results")
     data = os.path.join(outdir, f"exact-time-{args.steps}")
@@ -101,7 +131,14 @@ def main():
             for _ in range(args.reps):  # interleaved: load hits both alike
                 b = min(b, run_time(before_cmd))
                 a = min(a, run_time(after_cmd))
-            rows.append({"file": name, "mode": mode, "before_s": b, "after_s": a, "ratio": a / b})
+            row = {"file": name, "mode": mode, "before_s": b, "after_s": a, "ratio": a / b}
+            if args.instr_lines != "0":
+                n1, n2 = (int(x) for x in args.instr_lines.split(","))
+                tmp = os.path.join(data, "head.jsonl")
+                ib = per_line(args.before, flags, rest[0], rest[2], n1, n2, tmp)
+                ia = per_line(args.after, flags, rest[0], rest[2], n1, n2, tmp)
+                row.update({"before_instr": ib, "after_instr": ia, "instr_ratio": ia / ib})
+            rows.append(row)
         print(f"[{n}/30] {name}: discrete {rows[-2]['ratio']:.3f}x, dense {rows[-1]['ratio']:.3f}x "
               f"({time.time() - started:.0f} s)", file=sys.stderr, flush=True)
     with open(os.path.join(outdir, "exact-time.csv"), "w", newline="") as f:
@@ -109,8 +146,8 @@ def main():
         w.writeheader()
         w.writerows(rows)
 
-    def geo(mode):
-        r = [x["ratio"] for x in rows if x["mode"] == mode]
+    def geo(mode, key="ratio"):
+        r = [x[key] for x in rows if x["mode"] == mode]
         return math.exp(sum(math.log(v) for v in r) / len(r)), min(r), max(r)
 
     load = os.getloadavg()[0]
@@ -118,16 +155,31 @@ def main():
           f"at the end; {args.steps:,} lines per file, best of {args.reps}, before and after interleaved. Run time "
           f"{(time.time() - started) / 60:.1f} min. Command: `python3 bench/exact_time_bench.py --before OLD_RVC "
           f"--steps {args.steps}`.", "",
-          "| mode | after / before, geometric mean | min | max |", "|---|---|---|---|"]
+          "| mode | wall clock, after / before (geometric mean) | min | max |"
+          + (" instructions per line, after / before (geometric mean) | min | max |" if "instr_ratio" in rows[0] else ""),
+          "|---|---|---|---|" + ("---|---|---|" if "instr_ratio" in rows[0] else "")]
     for mode in ("discrete", "dense"):
         g, lo, hi = geo(mode)
-        md.append(f"| {mode} | {g:.3f}x | {lo:.3f}x | {hi:.3f}x |")
-    md += ["", "| file | discrete before (s) | after (s) | ratio | dense before (s) | after (s) | ratio |",
-           "|---|---|---|---|---|---|---|"]
+        line = f"| {mode} | {g:.3f}x | {lo:.3f}x | {hi:.3f}x |"
+        if "instr_ratio" in rows[0]:
+            gi, loi, hii = geo(mode, "instr_ratio")
+            line += f" {gi:.3f}x | {loi:.3f}x | {hii:.3f}x |"
+        md.append(line)
+    if "instr_ratio" in rows[0]:
+        md += ["", f"Instructions per line are counted by callgrind between the first {args.instr_lines.replace(',', ' and ')} "
+               "lines (start-up cancels); wall clock is best of --reps on the whole file and moves by +-30 % between "
+               "runs on this virtual machine, so the instruction ratio is the figure to read."]
+    instr = "instr_ratio" in rows[0]
+    md += ["", "| file | discrete before (s) | after (s) | ratio |" + (" instr/line before | after | ratio |" if instr else "")
+           + " dense before (s) | after (s) | ratio |" + (" instr/line before | after | ratio |" if instr else ""),
+           "|---|---|---|---|" + ("---|---|---|" if instr else "") + "---|---|---|" + ("---|---|---|" if instr else "")]
     for k in range(0, len(rows), 2):
-        d, e = rows[k], rows[k + 1]
-        md.append(f"| {d['file']} | {d['before_s']:.3f} | {d['after_s']:.3f} | {d['ratio']:.3f} | "
-                  f"{e['before_s']:.3f} | {e['after_s']:.3f} | {e['ratio']:.3f} |")
+        line = f"| {rows[k]['file']} |"
+        for r in (rows[k], rows[k + 1]):
+            line += f" {r['before_s']:.3f} | {r['after_s']:.3f} | {r['ratio']:.3f} |"
+            if instr:
+                line += f" {r['before_instr']:.0f} | {r['after_instr']:.0f} | {r['instr_ratio']:.3f} |"
+        md.append(line)
     text = "\n".join(md) + "\n"
     with open(os.path.join(outdir, "exact-time.md"), "w") as f:
         f.write(text)

@@ -94,7 +94,8 @@ bool JsonDecoder::learn_value(simdjson::ondemand::value value, KeyNode* node, La
       const size_t begin = static_cast<size_t>(token.data() - walk.base);
       walk.values.push_back({begin, begin + token.size()});
       walk.targets.push_back(target);
-      walk.convert.push_back(target != nullptr);
+      // A time slot no test reads is read from its text (exactly, to the nanosecond): no double.
+      walk.convert.push_back(target != nullptr && !(target->time_part == 1 && target->tests.empty()));
       return true;
     }
   }

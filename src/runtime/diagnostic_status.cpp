@@ -65,7 +65,9 @@ io::DiagStatus property_status(const DiagIdentity& who, const PropertyState& p, 
   }
   s.values.emplace_back("spec", p.spec);
   s.values.emplace_back("verdict", p.has_verdict ? (p.value ? "true" : "false") : "none");
-  s.values.emplace_back("verdict_time", p.has_verdict ? number(p.verdict_time) : "");
+  s.values.emplace_back("verdict_time", !p.has_verdict             ? std::string()
+                                         : !p.verdict_time_text.empty() ? p.verdict_time_text
+                                                                        : number(p.verdict_time));
   s.values.emplace_back("violations", std::to_string(p.violations));
   s.values.emplace_back("verdicts", std::to_string(p.verdicts));
   s.values.emplace_back("on_violation", io::to_string(p.on_violation));

@@ -22,6 +22,7 @@ struct PropertyState {
   bool has_verdict = false;
   bool value = true;         // the last verdict
   double verdict_time = 0;   // the last verdict's time (message time; a step index in discrete time)
+  std::string verdict_time_text;  // ... as printed: dense time's exact decimal seconds (empty: from verdict_time)
   uint64_t verdicts = 0;     // verdicts published (one per change, or per message with --all)
   uint64_t violations = 0;   // times it became violated
 };

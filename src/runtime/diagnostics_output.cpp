@@ -1,5 +1,7 @@
 #include "runtime/diagnostics_output.hpp"
 
+#include "spec/exact_time.hpp"
+
 #include <cstdio>
 
 #include "io/diagnostics.hpp"
@@ -65,6 +67,7 @@ void DiagnosticsOutput::on_verdict(const engine::Verdict& v) {
   p.has_verdict = true;
   p.value = v.value;
   p.verdict_time = v.time;
+  p.verdict_time_text = v.exact ? spec::seconds_text(v.time_ns) : std::string();  // exact, as verdict lines print it
   ++p.verdicts;
   // A level change goes out at once (with the counters of the last tick),
   // unless an array went out less than kMinGap ago: then the next tick

@@ -11,9 +11,41 @@ bool is_digit(char c) { return c >= '0' && c <= '9'; }
 
 }  // namespace
 
+// The usual stamp, [-+]digits[.digits] with at most 9 decimals and no exponent
+// ("1746721937.599626818"): integer arithmetic, no allocation. False (ns
+// untouched) for anything else, which the general reader below decides.
+static bool parse_plain_seconds(std::string_view text, int64_t& ns) {
+  const char* p = text.data();
+  const char* const end = p + text.size();
+  const bool negative = p != end && *p == '-';
+  if (p != end && (*p == '-' || *p == '+')) ++p;
+  // Unsigned arithmetic: a run too long to fit wraps harmlessly, and is refused by its length.
+  const char* const int_begin = p;
+  uint64_t whole = 0;
+  for (; p != end && static_cast<unsigned>(*p - '0') < 10; ++p) whole = whole * 10 + static_cast<unsigned>(*p - '0');
+  const auto int_digits = p - int_begin;
+  if (int_digits == 0 || int_digits > 10) return false;
+  uint64_t frac = 0;
+  long decimals = 0;
+  if (p != end && *p == '.') {
+    const char* const frac_begin = ++p;
+    for (; p != end && static_cast<unsigned>(*p - '0') < 10; ++p) frac = frac * 10 + static_cast<unsigned>(*p - '0');
+    decimals = p - frac_begin;
+    if (decimals == 0 || decimals > 9) return false;  // none: malformed; past the nanosecond: rounding
+  }
+  if (p != end || whole > 9223372036u) return false;  // an exponent, not a number, or (near) past int64 ns
+  static constexpr uint64_t kScale[] = {1000000000, 100000000, 10000000, 1000000, 100000,
+                                        10000,      1000,      100,      10,      1};
+  const uint64_t v = whole * 1000000000u + frac * kScale[decimals];  // < 2^64: 9223372036999999999 at most
+  if (v > static_cast<uint64_t>(std::numeric_limits<int64_t>::max())) return false;
+  ns = negative ? -static_cast<int64_t>(v) : static_cast<int64_t>(v);
+  return true;
+}
+
 SecondsStatus parse_seconds(std::string_view text, int64_t& ns) {
   while (!text.empty() && (text.back() == ' ' || text.back() == '\t' || text.back() == '\r' || text.back() == '\n'))
     text.remove_suffix(1);
+  if (parse_plain_seconds(text, ns)) return SecondsStatus::Ok;
   size_t i = 0;
   bool negative = false;
   if (i < text.size() && (text[i] == '-' || text[i] == '+')) negative = text[i++] == '-';

@@ -194,3 +194,16 @@ def test_the_results_store_records_where_the_stream_ended(rvc, tmp_path):
         assert r.returncode == 0, r.stderr
         (counters,), = sqlite3.connect(db).execute("SELECT counters FROM runs").fetchall()
         assert json.loads(counters)["stream_time"] == 7.25, counters
+
+
+def test_diagnostics_name_the_verdict_time_exactly(rvc, tmp_path):
+    # /diagnostics (diagnostic_msgs/DiagnosticArray as JSON lines here): the property's verdict_time is the
+    # stamp as it came in, not a double of epoch seconds (1746721937.6246268 before exact time).
+    trace = tmp_path / "t.jsonl"
+    trace.write_text('{"time": 1746721937.599626818, "p": true}\n{"time": 1746721937.624626818, "p": false}\n')
+    diag = tmp_path / "diag.jsonl"
+    r = run([rvc, "monitor", "--dense", "--spec", "{p}", "--input", f"file:{trace}", "--diagnostics", f"file:{diag}"])
+    assert r.returncode == 1, r.stderr
+    times = {kv["value"] for line in diag.read_text().splitlines() for s in json.loads(line)["status"]
+             for kv in s["values"] if kv["key"] == "verdict_time" and kv["value"]}
+    assert times == {"1746721937.599626818", "1746721937.624626818"}, times
